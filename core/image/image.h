@@ -1,0 +1,48 @@
+#pragma once
+// Images (float RGB, row-major, origin top-left), EXR and PNG I/O through OpenImageIO.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/math/vec.h"
+
+namespace penumbra {
+
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;  // 3 floats per pixel
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgb(size_t(w) * h * 3, 0.0f) {}
+  Rgb at(int x, int y) const {
+    size_t i = (size_t(y) * width + x) * 3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+  void set(int x, int y, const Rgb& c) {
+    size_t i = (size_t(y) * width + x) * 3;
+    rgb[i] = float(c.x);
+    rgb[i + 1] = float(c.y);
+    rgb[i + 2] = float(c.z);
+  }
+};
+
+// Metadata stored as EXR string attributes ("penumbra:method", ...).
+using ImageMetadata = std::map<std::string, std::string>;
+
+// Writes an EXR with channels R,G,B and, when `variance` is given, variance.R/G/B (per-pixel
+// variance of the mean). Throws std::runtime_error naming the path on failure.
+void write_exr(const std::string& path, const Image& color, const Image* variance,
+               const ImageMetadata& metadata);
+// The same EXR as bytes (for the farm's result stream).
+std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata);
+// Reads R,G,B (and metadata when asked). Throws std::runtime_error naming the path.
+Image read_exr(const std::string& path, ImageMetadata* metadata = nullptr,
+               Image* variance = nullptr);
+Image decode_exr(const std::string& bytes, ImageMetadata* metadata = nullptr,
+                 Image* variance = nullptr);
+// Tone-mapped 8-bit sRGB preview (exposure scale, then clamp and the sRGB curve).
+void write_png_preview(const std::string& path, const Image& color, double exposure = 1.0);
+
+}  // namespace penumbra
