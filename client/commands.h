@@ -1,0 +1,13 @@
+#pragma once
+// Subcommand registration for the penumbra CLI.
+#include <CLI/CLI.hpp>
+
+namespace penumbra {
+// render, probe, demo: core only.
+void add_local_commands(CLI::App& app);
+// submit, watch, list, status, cancel, fetch, workers: the farm's client (client/farm_*.cpp).
+void add_farm_commands(CLI::App& app);
+// The exit code the command that ran asked for (0 unless it reported a failure itself).
+int command_exit_code();
+void set_command_exit_code(int code);
+}  // namespace penumbra
