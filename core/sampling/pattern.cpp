@@ -1,0 +1,235 @@
+// The sample patterns of pattern.h. What each promises (tests/core/sampling/ checks it):
+//
+// random          independent uniform points.
+// stratified      one independent uniform point in each stratum: 1D, N equal strata; 2D, the
+//                 strata_grid() cells plus its 1D-stratified leftovers (strata.h).
+// uniform         the centre of each of those strata: no randomness at all.
+// uniform-jitter  the uniform pattern shifted by one random offset per stream, the same offset in
+//                 every stratum (Ramamoorthi et al. 2012, Sec. 4.2.2): 1D (i + xi) / N.
+// halton          radical inverses in bases 2 (x) and 3 (y) of indices 0..N-1, Owen scrambled
+//                 per stream (low_discrepancy.h). The first 2^a 3^b points put one point in each
+//                 box [i/2^a, (i+1)/2^a) x [j/3^b, (j+1)/3^b). 1D: base 2.
+// sobol           Sobol' dimensions 0 and 1 of indices 0..N-1, Owen scrambled per stream. For
+//                 N = 2^k the points form a (0,k,2)-net: one point in each elementary interval
+//                 of area 1/N. 1D: dimension 0 (the same construction as halton's 1D).
+// cmj             correlated multi-jittered sampling (Kensler 2013) on the strata_grid() cells:
+//                 one point per cell, and the cell points also fill each of the cells() thin
+//                 strata of x and of y exactly once (n-rooks). Leftovers as stratified. 1D:
+//                 multi-jittering has no second axis to correlate, so it is stratified.
+//
+// Halton and Sobol' ignore `aspect`: they are sequences, not grids.
+
+#include "core/sampling/pattern.h"
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "core/sampling/counter_random.h"
+#include "core/sampling/low_discrepancy.h"
+#include "core/sampling/strata.h"
+
+namespace penumbra {
+
+namespace {
+
+constexpr std::array<Pattern, 7> kAllPatterns = {
+    Pattern::Random, Pattern::Stratified, Pattern::Uniform, Pattern::UniformJitter,
+    Pattern::Halton, Pattern::Sobol,      Pattern::Cmj};
+
+// A uniform random integer in [0, bound) from 32 random bits (multiply-shift; the bias is at most
+// bound / 2^32, far below anything a pattern of a few thousand samples could show).
+inline uint32_t bounded_index(uint64_t bits, uint32_t bound) {
+  return static_cast<uint32_t>(((bits >> 32) * bound) >> 32);
+}
+
+// A uniformly random permutation of [0, size) (Fisher & Yates), drawn from the stream's
+// (sample, j) numbers. The storage is inline for small sizes, so small patterns never allocate.
+class Permutation {
+ public:
+  Permutation(const StreamRandom& rng, uint32_t sample, uint32_t size) : size_(size) {
+    if (size > kInline) heap_.resize(size);
+    uint32_t* p = data();
+    for (uint32_t i = 0; i < size; ++i) p[i] = i;
+    for (uint32_t i = size; i > 1; --i) {
+      uint32_t j = bounded_index(rng.bits(sample, i - 1), i);
+      std::swap(p[i - 1], p[j]);
+    }
+  }
+  uint32_t operator[](uint32_t i) const { return size_ > kInline ? heap_[i] : inline_[i]; }
+
+ private:
+  static constexpr uint32_t kInline = 64;
+  uint32_t* data() { return size_ > kInline ? heap_.data() : inline_.data(); }
+  uint32_t size_;
+  std::array<uint32_t, kInline> inline_{};
+  std::vector<uint32_t> heap_;
+};
+
+// Places the samples of a strata-grid pattern: `position_in_stratum(i)` gives sample i's relative
+// position (each coordinate in [0,1)) inside its cell or leftover band.
+template <typename PositionInStratum>
+void fill_strata_grid(const StrataGrid& grid, std::span<Vec2> out,
+                      PositionInStratum position_in_stratum) {
+  uint32_t cells = grid.cells();
+  for (uint32_t i = 0; i < cells; ++i) {
+    Vec2 u = position_in_stratum(i);
+    out[i] = {point_in_stratum(i % grid.columns, grid.columns, u.x),
+              point_in_stratum(i / grid.columns, grid.rows, u.y)};
+  }
+  // Leftovers: 1D strata along the long side, free across the short side.
+  for (uint32_t band = 0; band < grid.leftover; ++band) {
+    uint32_t i = cells + band;
+    Vec2 u = position_in_stratum(i);
+    if (grid.leftover_along_x) {
+      out[i] = {point_in_stratum(band, grid.leftover, u.x), u.y};
+    } else {
+      out[i] = {u.x, point_in_stratum(band, grid.leftover, u.y)};
+    }
+  }
+}
+
+// Kensler 2013, Sec. 3 (correlated multi-jittering) on an m x n grid: sample s sits in cell
+// (s % m, s / m); its x lies in thin stratum col * n + P_x[row] of the m n strata of [0,1), its y
+// in thin stratum row * m + P_y[col], where P_x shuffles [0,n) and P_y shuffles [0,m) once per
+// stream (the "correlated" part: every row shares one shuffle, every column one).
+void correlated_multi_jittered(const StreamRandom& rng, const StrataGrid& grid,
+                               std::span<Vec2> out) {
+  uint32_t m = grid.columns;
+  uint32_t n = grid.rows;
+  uint32_t cells = grid.cells();
+  Permutation x_substratum_of_row(rng, kRowPermutationSample, n);
+  Permutation y_substratum_of_column(rng, kColumnPermutationSample, m);
+  for (uint32_t s = 0; s < cells; ++s) {
+    uint32_t column = s % m;
+    uint32_t row = s / m;
+    out[s] = {point_in_stratum(column * n + x_substratum_of_row[row], cells, rng.uniform(s, 0)),
+              point_in_stratum(row * m + y_substratum_of_column[column], cells, rng.uniform(s, 1))};
+  }
+  fill_strata_grid(StrataGrid{0, 0, grid.leftover, grid.leftover_along_x}, out.subspan(cells),
+                   [&](uint32_t band) {
+                     uint32_t s = cells + band;
+                     return Vec2(rng.uniform(s, 0), rng.uniform(s, 1));
+                   });
+}
+
+// Owen-scrambled base-2 coordinate of point `index`: `unscrambled` holds its digits as a 0.32
+// fraction, of which the first `levels` separate the stream's points (low_discrepancy.h).
+inline double scrambled_base2(const StreamRandom& rng, uint32_t index, uint32_t dimension,
+                              uint32_t unscrambled, int levels, uint64_t seed) {
+  return fraction_from_base2_digits(owen_scramble_base2(unscrambled, levels, seed), levels,
+                                    rng.bits(index, dimension));
+}
+
+}  // namespace
+
+std::string_view pattern_name(Pattern pattern) {
+  switch (pattern) {
+    case Pattern::Random:
+      return "random";
+    case Pattern::Stratified:
+      return "stratified";
+    case Pattern::Uniform:
+      return "uniform";
+    case Pattern::UniformJitter:
+      return "uniform-jitter";
+    case Pattern::Halton:
+      return "halton";
+    case Pattern::Sobol:
+      return "sobol";
+    case Pattern::Cmj:
+      return "cmj";
+  }
+  return "unknown";
+}
+
+std::optional<Pattern> parse_pattern(std::string_view name) {
+  for (Pattern pattern : kAllPatterns) {
+    if (pattern_name(pattern) == name) return pattern;
+  }
+  return std::nullopt;
+}
+
+void generate_1d(Pattern pattern, const StreamKey& key, std::span<double> out) {
+  uint32_t n = static_cast<uint32_t>(out.size());
+  StreamRandom rng(key);
+  switch (pattern) {
+    case Pattern::Random:
+      for (uint32_t i = 0; i < n; ++i) out[i] = rng.uniform(i, 0);
+      return;
+    case Pattern::Stratified:
+    case Pattern::Cmj:
+      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(i, n, rng.uniform(i, 0));
+      return;
+    case Pattern::Uniform:
+      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(i, n, 0.5);
+      return;
+    case Pattern::UniformJitter: {
+      double offset = rng.uniform(kStreamDrawSample, 0);
+      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(i, n, offset);
+      return;
+    }
+    case Pattern::Halton:
+    case Pattern::Sobol: {
+      int levels = digits_to_separate(2, n);
+      uint64_t seed = owen_seed(key, 0);
+      for (uint32_t i = 0; i < n; ++i) {
+        out[i] = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels, seed);
+      }
+      return;
+    }
+  }
+}
+
+void generate_2d(Pattern pattern, const StreamKey& key, double aspect, std::span<Vec2> out) {
+  uint32_t n = static_cast<uint32_t>(out.size());
+  if (n == 0) return;
+  StreamRandom rng(key);
+  switch (pattern) {
+    case Pattern::Random:
+      for (uint32_t i = 0; i < n; ++i) out[i] = {rng.uniform(i, 0), rng.uniform(i, 1)};
+      return;
+    case Pattern::Stratified:
+      fill_strata_grid(strata_grid(n, aspect), out,
+                       [&](uint32_t i) { return Vec2(rng.uniform(i, 0), rng.uniform(i, 1)); });
+      return;
+    case Pattern::Uniform:
+      fill_strata_grid(strata_grid(n, aspect), out, [](uint32_t) { return Vec2(0.5, 0.5); });
+      return;
+    case Pattern::UniformJitter: {
+      Vec2 offset(rng.uniform(kStreamDrawSample, 0), rng.uniform(kStreamDrawSample, 1));
+      fill_strata_grid(strata_grid(n, aspect), out, [&](uint32_t) { return offset; });
+      return;
+    }
+    case Pattern::Halton: {
+      int levels2 = digits_to_separate(2, n);
+      int levels3 = digits_to_separate(3, n);
+      uint64_t strata3 = 1;
+      for (int level = 0; level < levels3; ++level) strata3 *= 3;
+      uint64_t seed_x = owen_seed(key, 0);
+      uint64_t seed_y = owen_seed(key, 1);
+      for (uint32_t i = 0; i < n; ++i) {
+        double x = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels2, seed_x);
+        // Base 3: the scrambled digits pick one of 3^levels3 strata, the rest is uniform in it.
+        uint64_t stratum = owen_scramble_base3(i, levels3, seed_y);
+        out[i] = {x, point_in_stratum(stratum, strata3, rng.uniform(i, 1))};
+      }
+      return;
+    }
+    case Pattern::Sobol: {
+      int levels = digits_to_separate(2, n);
+      uint64_t seed_x = owen_seed(key, 0);
+      uint64_t seed_y = owen_seed(key, 1);
+      for (uint32_t i = 0; i < n; ++i) {
+        out[i] = {scrambled_base2(rng, i, 0, sobol_bits(i, 0), levels, seed_x),
+                  scrambled_base2(rng, i, 1, sobol_bits(i, 1), levels, seed_y)};
+      }
+      return;
+    }
+    case Pattern::Cmj:
+      correlated_multi_jittered(rng, strata_grid(n, aspect), out);
+      return;
+  }
+}
+
+}  // namespace penumbra
