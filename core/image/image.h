@@ -31,13 +31,21 @@ struct Image {
 // Metadata stored as EXR string attributes ("penumbra:method", ...).
 using ImageMetadata = std::map<std::string, std::string>;
 
+// Channel type of a written EXR: float round-trips bit-exactly; half is half the size.
+enum class ExrPixelType { Float, Half };
+
 // Writes an EXR with channels R,G,B and, when `variance` is given, variance.R/G/B (per-pixel
-// variance of the mean). Throws std::runtime_error naming the path on failure.
+// variance of the mean). Metadata keys are written as string attributes named with the
+// "penumbra:" prefix (added when a key lacks it). Throws std::runtime_error naming the path and
+// what failed.
 void write_exr(const std::string& path, const Image& color, const Image* variance,
-               const ImageMetadata& metadata);
-// The same EXR as bytes (for the farm's result stream).
-std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata);
-// Reads R,G,B (and metadata when asked). Throws std::runtime_error naming the path.
+               const ImageMetadata& metadata, ExrPixelType pixel_type = ExrPixelType::Float);
+// The same EXR as bytes (for the farm's result stream), encoded in memory (no temporary file).
+std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata,
+                       ExrPixelType pixel_type = ExrPixelType::Float);
+// Reads R,G,B (and metadata when asked: every "penumbra:" string attribute, keys with the
+// prefix). `variance`, when given, receives variance.R/G/B, or an empty (0x0) image when the file
+// has none. Throws std::runtime_error naming the path and what failed.
 Image read_exr(const std::string& path, ImageMetadata* metadata = nullptr,
                Image* variance = nullptr);
 Image decode_exr(const std::string& bytes, ImageMetadata* metadata = nullptr,
