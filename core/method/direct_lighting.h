@@ -1,0 +1,53 @@
+#pragma once
+// The direct-lighting estimator of a method at one shading point: for each light, each term of
+// the method draws its samples (stratified by the sampler over the term's count), every sample's
+// contribution f * G * V * Le / p is weighted by the method's combination, and the lights' sums
+// add up (Salesin & Jarosz Eq. 1-2; Veach's multi-sample MIS with counts n_i).
+//
+// Combinations (weights of a sample x drawn by term i; n_k = count of term k, p_k its area pdf):
+//   balance  w_i = n_i p_i / sum_k n_k p_k
+//   power    w_i = (n_i p_i)^2 / sum_k (n_k p_k)^2            (Veach's beta = 2)
+//   avg      w_i = 1 / T                                        (plain average of the T estimates)
+
+#include <vector>
+
+#include "core/method/method.h"
+#include "core/method/visibility.h"
+#include "core/sampling/pattern.h"
+#include "core/scene/scene.h"
+#include "core/strategies/strategy.h"
+
+namespace penumbra {
+
+class DirectLighting {
+ public:
+  // Throws FormatError (path "method") when a term or combination cannot run on this scene:
+  // not available yet, or not defined for a light or material of the scene (the message names
+  // the strategy, the light or material, and why).
+  DirectLighting(const Scene& scene, const MethodSpec& method);
+
+  // Reflected radiance towards sp.wo. `key` identifies the shading point's random streams (its
+  // `stream` field is ignored: streams are assigned per light and term). Every term draws
+  // count * sample_multiplier samples (the probe's N).
+  Rgb estimate(const ShadingPoint& sp, const Visibility& visibility, Pattern pattern,
+               const StreamKey& key, int sample_multiplier = 1) const;
+
+  // The combination weights of a point on `light_index` drawn by `term`, for tests: the weights
+  // of all terms at the same point sum to one wherever some pdf is nonzero.
+  std::vector<double> weights(const ShadingPoint& sp, int light_index, const Vec3& light_point,
+                              int sample_multiplier = 1) const;
+
+  const MethodSpec& method() const { return method_; }
+
+ private:
+  const Scene* scene_;
+  MethodSpec method_;
+};
+
+// Stream numbers: 0 is the pixel jitter; each (light, term) pair gets its own.
+inline constexpr uint32_t kPixelJitterStream = 0;
+inline uint32_t light_term_stream(int light_index, int term_index) {
+  return 1 + uint32_t(light_index) * 32 + uint32_t(term_index);
+}
+
+}  // namespace penumbra
