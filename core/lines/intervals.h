@@ -1,0 +1,133 @@
+#pragma once
+// The visible part of a line sample: a sorted list of disjoint sub-intervals of the segment's
+// parameter t in [0,1] (Billen & Dutré 2016 Sec. 5.2: "we start with a fully visible line
+// sample; every back-projected intersection clips a part from the still visible intervals").
+//
+// Cuts are closed intervals and the visible pieces are the closures of the open components of
+// [0,1] minus the union of all cuts. Two cuts that touch ([t0,t1] and [t1,t2]) leave nothing
+// visible between them, so a closed mesh whose cuts share endpoints bit for bit never leaks.
+// The result does not depend on the order in which cuts are subtracted.
+//
+// Storage: up to kInlineCapacity pieces inline (no allocation in the common case), then the
+// heap. Double precision: the endpoints are copied from exact leaf computations, never
+// recomputed, so pieces that should touch do.
+
+#include <algorithm>
+#include <cstddef>
+#include <cstring>
+#include <memory>
+
+namespace penumbra {
+
+struct Interval {
+  double lo = 0, hi = 0;
+  double length() const { return hi - lo; }
+};
+
+class IntervalList {
+ public:
+  static constexpr size_t kInlineCapacity = 8;
+
+  // A new list holds the whole segment [0,1], visible.
+  IntervalList() { reset(); }
+  IntervalList(const IntervalList& other) { assign(other); }
+  IntervalList& operator=(const IntervalList& other) {
+    if (this != &other) assign(other);
+    return *this;
+  }
+  IntervalList(IntervalList&& other) noexcept { assign(other); }
+  IntervalList& operator=(IntervalList&& other) noexcept {
+    if (this != &other) assign(other);
+    return *this;
+  }
+
+  // One visible piece [lo, hi] (nothing visible when lo >= hi).
+  void reset(double lo = 0, double hi = 1) {
+    size_ = 0;
+    if (lo < hi) data()[size_++] = {lo, hi};
+  }
+  // Nothing visible.
+  void clear() { size_ = 0; }
+
+  // Removes the closed interval [lo, hi]. Empty or NaN cuts (not lo < hi) change nothing.
+  void subtract(double lo, double hi) {
+    if (!(lo < hi) || size_ == 0) return;
+    Interval* pieces = data();
+    // First piece that ends after the cut starts (a piece ending exactly at lo is untouched).
+    size_t first = 0;
+    while (first < size_ && pieces[first].hi <= lo) ++first;
+    // One past the last piece that starts before the cut ends.
+    size_t last = first;
+    while (last < size_ && pieces[last].lo < hi) ++last;
+    if (first == last) return;
+
+    Interval replacement[2];
+    size_t replacement_count = 0;
+    if (pieces[first].lo < lo) replacement[replacement_count++] = {pieces[first].lo, lo};
+    if (hi < pieces[last - 1].hi) replacement[replacement_count++] = {hi, pieces[last - 1].hi};
+
+    size_t removed = last - first;
+    size_t new_size = size_ - removed + replacement_count;
+    if (new_size > capacity_) grow(new_size);
+    pieces = data();
+    // Shift the tail, then write the replacement pieces.
+    if (replacement_count != removed) {
+      std::memmove(pieces + first + replacement_count, pieces + last,
+                   (size_ - last) * sizeof(Interval));
+    }
+    for (size_t i = 0; i < replacement_count; ++i) pieces[first + i] = replacement[i];
+    size_ = new_size;
+  }
+
+  // Would subtracting [lo, hi] change the list? (Some piece overlaps the open interval.)
+  bool overlaps(double lo, double hi) const {
+    const Interval* pieces = data();
+    for (size_t i = 0; i < size_; ++i) {
+      if (pieces[i].hi <= lo) continue;
+      return pieces[i].lo < hi;
+    }
+    return false;
+  }
+
+  bool fully_occluded() const { return size_ == 0; }
+  double visible_length() const {
+    double total = 0;
+    for (size_t i = 0; i < size_; ++i) total += data()[i].length();
+    return total;
+  }
+  // Smallest and largest visible t (only when not fully occluded).
+  double lowest() const { return data()[0].lo; }
+  double highest() const { return data()[size_ - 1].hi; }
+
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const Interval& operator[](size_t i) const { return data()[i]; }
+  const Interval* begin() const { return data(); }
+  const Interval* end() const { return data() + size_; }
+
+ private:
+  Interval* data() { return heap_ ? heap_.get() : inline_; }
+  const Interval* data() const { return heap_ ? heap_.get() : inline_; }
+
+  void grow(size_t needed) {
+    size_t new_capacity = std::max(needed, 2 * capacity_);
+    std::unique_ptr<Interval[]> storage(new Interval[new_capacity]);
+    std::copy(data(), data() + size_, storage.get());
+    heap_ = std::move(storage);
+    capacity_ = new_capacity;
+  }
+
+  void assign(const IntervalList& other) {
+    size_ = 0;
+    if (other.size_ > capacity_) grow(other.size_);
+    std::copy(other.begin(), other.end(), data());
+    size_ = other.size_;
+  }
+
+  Interval inline_[kInlineCapacity];
+  std::unique_ptr<Interval[]> heap_;
+  size_t size_ = 0;
+  size_t capacity_ = kInlineCapacity;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,449 @@
+#include "core/lines/line_query.h"
+
+#include <embree3/rtcore.h>
+#include <xmmintrin.h>
+
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <new>
+#include <stdexcept>
+#include <string>
+
+#include "core/scene/scene.h"
+
+namespace penumbra {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Build: Embree's rtcBuildBVH calls these to make a tree of our temporary nodes (allocated from
+// Embree's thread-local allocator, freed with the RTCBVH), which we then flatten.
+
+struct BuildNode {
+  bool is_leaf;
+};
+
+struct BuildInner {
+  BuildNode base{false};
+  unsigned child_count = 0;
+  BuildNode* children[4] = {};
+  RTCBounds bounds[4] = {};
+};
+
+struct BuildLeaf {
+  BuildNode base{true};
+  unsigned triangle_count = 0;
+  uint32_t triangles[RTC_BUILD_MAX_PRIMITIVES_PER_LEAF] = {};
+};
+
+void* create_inner(RTCThreadLocalAllocator allocator, unsigned int, void*) {
+  void* memory = rtcThreadLocalAlloc(allocator, sizeof(BuildInner), 16);
+  return new (memory) BuildInner();
+}
+
+void set_children(void* node, void** children, unsigned int child_count, void*) {
+  auto* inner = static_cast<BuildInner*>(node);
+  inner->child_count = child_count;
+  for (unsigned i = 0; i < child_count; ++i)
+    inner->children[i] = static_cast<BuildNode*>(children[i]);
+}
+
+void set_bounds(void* node, const RTCBounds** bounds, unsigned int child_count, void*) {
+  auto* inner = static_cast<BuildInner*>(node);
+  for (unsigned i = 0; i < child_count; ++i) inner->bounds[i] = *bounds[i];
+}
+
+void* create_leaf(RTCThreadLocalAllocator allocator, const RTCBuildPrimitive* primitives,
+                  size_t primitive_count, void*) {
+  void* memory = rtcThreadLocalAlloc(allocator, sizeof(BuildLeaf), 16);
+  auto* leaf = new (memory) BuildLeaf();
+  leaf->triangle_count = static_cast<unsigned>(primitive_count);
+  for (size_t i = 0; i < primitive_count; ++i) leaf->triangles[i] = primitives[i].primID;
+  return leaf;
+}
+
+// Float bounds that contain the double value.
+float round_down(double value) {
+  float f = static_cast<float>(value);
+  return static_cast<double>(f) > value ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                        : f;
+}
+float round_up(double value) {
+  float f = static_cast<float>(value);
+  return static_cast<double>(f) < value ? std::nextafter(f, std::numeric_limits<float>::infinity())
+                                        : f;
+}
+
+RTCBuildQuality embree_quality(LineQueryBuildQuality quality) {
+  switch (quality) {
+    case LineQueryBuildQuality::Low:
+      return RTC_BUILD_QUALITY_LOW;
+    case LineQueryBuildQuality::High:
+      return RTC_BUILD_QUALITY_HIGH;
+    default:
+      return RTC_BUILD_QUALITY_MEDIUM;
+  }
+}
+
+Vec3 absolute(const Vec3& v) {
+  return {std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Traversal: a linear function f(p) = dot(gradient, p) + offset evaluated over four boxes at
+// once, as a conservative range [lower, upper] that contains the exact range over each box.
+
+struct BoxRange4 {
+  __m128 gradient[3];
+  __m128 offset_lower, offset_upper;  // offset -+ the float error bound
+  int lower_corner[3];                // per axis: 0 = take the box's lower bound, 1 = upper
+
+  BoxRange4(const Vec3& gradient_d, const Vec3& x, const Vec3& scene_max_abs) {
+    double offset = -dot(gradient_d, x);
+    // Float error of evaluating dot(g, p) + offset with g, offset, p rounded to float: a few
+    // ulps of the largest partial sum, bounded by |g|.(max |p| + |x|); 32 ulps to be safe.
+    double error =
+        32 * (FLT_EPSILON / 2) *
+        (dot(absolute(gradient_d), scene_max_abs) + dot(absolute(gradient_d), absolute(x)));
+    for (int k = 0; k < 3; ++k) {
+      gradient[k] = _mm_set1_ps(static_cast<float>(gradient_d[k]));
+      lower_corner[k] = gradient_d[k] >= 0 ? 0 : 1;
+    }
+    offset_lower = _mm_set1_ps(round_down(offset - error));
+    offset_upper = _mm_set1_ps(round_up(offset + error));
+  }
+
+  void evaluate(const LineQuery::Node& node, __m128& lower, __m128& upper) const {
+    __m128 lo = offset_lower, hi = offset_upper;
+    for (int k = 0; k < 3; ++k) {
+      __m128 near = _mm_load_ps(node.bounds[lower_corner[k]][k]);
+      __m128 far = _mm_load_ps(node.bounds[1 - lower_corner[k]][k]);
+      lo = _mm_add_ps(lo, _mm_mul_ps(gradient[k], near));
+      hi = _mm_add_ps(hi, _mm_mul_ps(gradient[k], far));
+    }
+    lower = lo;
+    upper = hi;
+  }
+};
+
+// Stack entry: a node or leaf code with the t-range its box projects to (re-checked when popped,
+// since cuts found in the meantime may have covered it).
+struct StackEntry {
+  uint32_t code;
+  float t_lower, t_upper;
+};
+
+// Slack on projected t-ranges (t is in [0,1]): float rounding of one add and one divide.
+constexpr float kProjectionSlack = 1e-6f;
+constexpr int kStackCapacity = 256;  // depth <= 32 (Embree's maxDepth), 3 entries per level
+
+}  // namespace
+
+LineQuery::LineQuery(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,
+                     const LineQueryOptions& options)
+    : options_(options) {
+  build(positions, indices);
+}
+
+LineQuery::LineQuery(const Scene& scene, const LineQueryOptions& options) : options_(options) {
+  build(scene.positions, scene.indices);
+}
+
+void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices) {
+  if (options_.max_leaf_size < 1 || options_.max_leaf_size > (1u << kCountBits))
+    throw std::invalid_argument("LineQuery: max_leaf_size must be in [1, 32], got " +
+                                std::to_string(options_.max_leaf_size));
+  // Occluder triangles, canonical vertex order, and their float boxes.
+  std::vector<Triangle> occluders;
+  std::vector<RTCBuildPrimitive> primitives;
+  size_t input_count = indices.size() / 3;
+  occluders.reserve(input_count);
+  primitives.reserve(input_count);
+  scene_max_abs_ = {0, 0, 0};
+  for (size_t i = 0; i < input_count; ++i) {
+    Triangle triangle{{positions.at(indices[3 * i]), positions.at(indices[3 * i + 1]),
+                       positions.at(indices[3 * i + 2])}};
+    if (!is_occluder_triangle(triangle.v[0], triangle.v[1], triangle.v[2])) continue;
+    order_canonically(triangle.v[0], triangle.v[1], triangle.v[2]);
+    RTCBuildPrimitive primitive;
+    Vec3 lower = triangle.v[0], upper = triangle.v[0];
+    for (const Vec3& v : triangle.v) {
+      for (int k = 0; k < 3; ++k) {
+        lower[k] = std::min(lower[k], v[k]);
+        upper[k] = std::max(upper[k], v[k]);
+        scene_max_abs_[k] = std::max(scene_max_abs_[k], std::fabs(v[k]));
+      }
+    }
+    primitive.lower_x = round_down(lower.x);
+    primitive.lower_y = round_down(lower.y);
+    primitive.lower_z = round_down(lower.z);
+    primitive.upper_x = round_up(upper.x);
+    primitive.upper_y = round_up(upper.y);
+    primitive.upper_z = round_up(upper.z);
+    primitive.geomID = 0;
+    primitive.primID = static_cast<unsigned>(occluders.size());
+    primitives.push_back(primitive);
+    occluders.push_back(triangle);
+  }
+  nodes_.clear();
+  triangles_.clear();
+  if (occluders.empty()) return;
+  if (occluders.size() >= (size_t{1} << (31 - kCountBits)))
+    throw std::invalid_argument("LineQuery: too many triangles (" +
+                                std::to_string(occluders.size()) + ")");
+
+  RTCDevice device = rtcNewDevice(nullptr);
+  if (!device) throw std::runtime_error("LineQuery: cannot create an Embree device");
+  RTCBVH bvh = rtcNewBVH(device);
+  RTCBuildArguments arguments = rtcDefaultBuildArguments();
+  arguments.byteSize = sizeof(arguments);
+  arguments.buildQuality = embree_quality(options_.build_quality);
+  arguments.maxBranchingFactor = 4;
+  arguments.maxDepth = 32;
+  arguments.sahBlockSize = 1;
+  arguments.minLeafSize = 1;
+  arguments.maxLeafSize = options_.max_leaf_size;
+  arguments.traversalCost = 1.0f;
+  arguments.intersectionCost = 1.0f;
+  arguments.bvh = bvh;
+  arguments.primitives = primitives.data();
+  arguments.primitiveCount = primitives.size();
+  arguments.primitiveArrayCapacity = primitives.size();
+  arguments.createNode = create_inner;
+  arguments.setNodeChildren = set_children;
+  arguments.setNodeBounds = set_bounds;
+  arguments.createLeaf = create_leaf;
+  arguments.splitPrimitive = nullptr;  // no spatial splits
+  arguments.buildProgress = nullptr;
+  arguments.userPtr = nullptr;
+  auto* root = static_cast<BuildNode*>(rtcBuildBVH(&arguments));
+  if (!root) {
+    rtcReleaseBVH(bvh);
+    rtcReleaseDevice(device);
+    throw std::runtime_error("LineQuery: rtcBuildBVH failed (Embree error " +
+                             std::to_string(static_cast<int>(rtcGetDeviceError(device))) + ")");
+  }
+
+  // Flatten depth first: a node's children get their codes after the node has its slot.
+  triangles_.reserve(occluders.size());
+  nodes_.reserve(occluders.size() / 2 + 1);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto new_node = [&]() {
+    Node node;
+    for (auto& side : node.bounds)
+      for (auto& axis : side)
+        for (float& value : axis) value = nan;
+    for (uint32_t& code : node.child) code = 0;
+    nodes_.push_back(node);
+    return static_cast<uint32_t>(nodes_.size() - 1);
+  };
+  auto flatten_leaf = [&](const BuildLeaf* leaf) {
+    uint32_t first = static_cast<uint32_t>(triangles_.size());
+    for (unsigned i = 0; i < leaf->triangle_count; ++i)
+      triangles_.push_back(occluders[leaf->triangles[i]]);
+    return kLeafFlag | (first << kCountBits) | (leaf->triangle_count - 1);
+  };
+  auto set_slot = [&](uint32_t index, int slot, const RTCBounds& bounds, uint32_t code) {
+    Node& node = nodes_[index];
+    node.bounds[0][0][slot] = bounds.lower_x;
+    node.bounds[0][1][slot] = bounds.lower_y;
+    node.bounds[0][2][slot] = bounds.lower_z;
+    node.bounds[1][0][slot] = bounds.upper_x;
+    node.bounds[1][1][slot] = bounds.upper_y;
+    node.bounds[1][2][slot] = bounds.upper_z;
+    node.child[slot] = code;
+  };
+  // Returns the code of the flattened subtree.
+  auto flatten = [&](auto&& self, const BuildNode* node) -> uint32_t {
+    if (node->is_leaf) return flatten_leaf(reinterpret_cast<const BuildLeaf*>(node));
+    auto* inner = reinterpret_cast<const BuildInner*>(node);
+    uint32_t index = new_node();
+    for (unsigned i = 0; i < inner->child_count; ++i) {
+      uint32_t code = self(self, inner->children[i]);
+      set_slot(index, static_cast<int>(i), inner->bounds[i], code);
+    }
+    return index;
+  };
+  if (root->is_leaf) {
+    // A single leaf: give it a root node, with the union of its triangles' boxes.
+    uint32_t index = new_node();
+    RTCBounds bounds{primitives[0].lower_x, primitives[0].lower_y, primitives[0].lower_z, 0,
+                     primitives[0].upper_x, primitives[0].upper_y, primitives[0].upper_z, 0};
+    for (const RTCBuildPrimitive& p : primitives) {
+      bounds.lower_x = std::min(bounds.lower_x, p.lower_x);
+      bounds.lower_y = std::min(bounds.lower_y, p.lower_y);
+      bounds.lower_z = std::min(bounds.lower_z, p.lower_z);
+      bounds.upper_x = std::max(bounds.upper_x, p.upper_x);
+      bounds.upper_y = std::max(bounds.upper_y, p.upper_y);
+      bounds.upper_z = std::max(bounds.upper_z, p.upper_z);
+    }
+    set_slot(index, 0, bounds, flatten_leaf(reinterpret_cast<const BuildLeaf*>(root)));
+  } else {
+    flatten(flatten, root);
+  }
+  rtcReleaseBVH(bvh);
+  rtcReleaseDevice(device);
+}
+
+void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, IntervalList& out,
+                                  LineQueryStats* stats) const {
+  out.reset();
+  if (!is_finite(x) || !is_finite(a) || !is_finite(b)) {
+    out.clear();
+    return;
+  }
+  std::optional<ShadowTriangle> shadow = ShadowTriangle::make(x, a, b, options_.tolerances);
+  if (!shadow) {
+    // Degenerate shadow triangle: the segment is seen along one direction.
+    if (occluded(x, 0.5 * (a + b))) out.clear();
+    return;
+  }
+  if (nodes_.empty()) return;
+
+  // The shadow triangle's planes as linear functions over boxes (see shadow_triangle.h):
+  // distance to the plane, alpha, beta and depth s = alpha + beta.
+  const BoxRange4 distance_range(shadow->plane_normal, x, scene_max_abs_);
+  const BoxRange4 alpha_range(shadow->alpha_gradient, x, scene_max_abs_);
+  const BoxRange4 beta_range(shadow->beta_gradient, x, scene_max_abs_);
+  const BoxRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 tiny = _mm_set1_ps(FLT_MIN);
+  const __m128 s_min = _mm_set1_ps(static_cast<float>(shadow->s_min));
+  const __m128 s_max = _mm_set1_ps(static_cast<float>(shadow->s_max));
+
+  StackEntry stack[kStackCapacity];
+  int top = 0;
+  stack[top++] = {0, 0.0f, 1.0f};
+  uint64_t nodes_visited = 0, triangles_tested = 0, cuts = 0;
+
+  while (top > 0) {
+    const StackEntry entry = stack[--top];
+    // Skip what cuts found since the push have covered.
+    if (!out.overlaps(entry.t_lower - kProjectionSlack, entry.t_upper + kProjectionSlack)) continue;
+
+    if (entry.code & kLeafFlag) {
+      // Leaf: exact crossings in double.
+      uint32_t first = (entry.code & ~kLeafFlag) >> kCountBits;
+      uint32_t count = (entry.code & ((1u << kCountBits) - 1)) + 1;
+      for (uint32_t i = first; i < first + count; ++i) {
+        const Triangle& triangle = triangles_[i];
+        ++triangles_tested;
+        std::optional<Interval> cut =
+            occluder_cut(*shadow, triangle.v[0], triangle.v[1], triangle.v[2]);
+        if (!cut) continue;
+        ++cuts;
+        out.subtract(cut->lo, cut->hi);
+        if (out.fully_occluded()) {
+          top = 0;  // nothing stays visible: done
+          break;
+        }
+      }
+      continue;
+    }
+
+    const Node& node = nodes_[entry.code];
+    ++nodes_visited;
+    __m128 distance_lower, distance_upper, alpha_lower, alpha_upper, beta_lower, beta_upper,
+        depth_lower, depth_upper;
+    distance_range.evaluate(node, distance_lower, distance_upper);
+    alpha_range.evaluate(node, alpha_lower, alpha_upper);
+    beta_range.evaluate(node, beta_lower, beta_upper);
+    depth_range.evaluate(node, depth_lower, depth_upper);
+    // Box against the shadow plane, the side planes through x (alpha >= 0, beta >= 0), the
+    // plane through the segment (s <= s_max) and the self-occlusion plane (s >= s_min).
+    // Ordered comparisons: NaN boxes (empty slots) fail.
+    __m128 keep =
+        _mm_and_ps(_mm_cmple_ps(distance_lower, zero), _mm_cmpge_ps(distance_upper, zero));
+    keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
+    keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
+    keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, s_min));
+    keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, s_max));
+    int mask = _mm_movemask_ps(keep);
+    if (mask == 0) continue;
+
+    // Project the boxes from x onto the segment. Within the wedge (alpha, beta >= 0),
+    // t = beta / (alpha + beta) grows with beta and falls with alpha, so over the box's
+    // [alpha] x [beta] rectangle its range is [beta_lo / (alpha_hi + beta_lo),
+    // beta_hi / (alpha_lo + beta_hi)] with negative bounds clamped to 0.
+    __m128 beta_lower_clamped = _mm_max_ps(beta_lower, zero);
+    __m128 alpha_lower_clamped = _mm_max_ps(alpha_lower, zero);
+    __m128 t_lower = _mm_div_ps(beta_lower_clamped,
+                                _mm_max_ps(_mm_add_ps(alpha_upper, beta_lower_clamped), tiny));
+    __m128 t_upper =
+        _mm_div_ps(beta_upper, _mm_max_ps(_mm_add_ps(alpha_lower_clamped, beta_upper), tiny));
+    alignas(16) float t_lowers[4], t_uppers[4], depth_lowers[4];
+    _mm_store_ps(t_lowers, t_lower);
+    _mm_store_ps(t_uppers, t_upper);
+    _mm_store_ps(depth_lowers, depth_lower);
+
+    // Surviving children whose projection is not yet occluded, nearest to x first.
+    int order[4];
+    int kept = 0;
+    for (int slot = 0; slot < 4; ++slot) {
+      if (!(mask & (1 << slot))) continue;
+      if (!out.overlaps(t_lowers[slot] - kProjectionSlack, t_uppers[slot] + kProjectionSlack))
+        continue;
+      int position = kept++;
+      while (position > 0 && depth_lowers[order[position - 1]] > depth_lowers[slot]) {
+        order[position] = order[position - 1];
+        --position;
+      }
+      order[position] = slot;
+    }
+    // Push far to near so the nearest is popped first.
+    for (int i = kept - 1; i >= 0; --i) {
+      int slot = order[i];
+      stack[top++] = {node.child[slot], t_lowers[slot], t_uppers[slot]};
+    }
+  }
+  if (stats) {
+    stats->nodes_visited += nodes_visited;
+    stats->triangles_tested += triangles_tested;
+    stats->cuts += cuts;
+  }
+}
+
+bool LineQuery::occluded(const Vec3& x, const Vec3& p) const {
+  if (nodes_.empty() || !is_finite(x) || !is_finite(p)) return false;
+  const double s_min = options_.tolerances.self_occlusion_epsilon;
+  const double s_max = 1 - options_.tolerances.light_plane_epsilon;
+  Vec3 direction = p - x;
+  // Boxes are padded by a few float ulps of the scene's extent before the slab test.
+  double pad = 4 * FLT_EPSILON * (max_component(scene_max_abs_) + max_component(absolute(x)));
+  uint32_t stack[kStackCapacity];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    uint32_t code = stack[--top];
+    if (code & kLeafFlag) {
+      uint32_t first = (code & ~kLeafFlag) >> kCountBits;
+      uint32_t count = (code & ((1u << kCountBits) - 1)) + 1;
+      for (uint32_t i = first; i < first + count; ++i) {
+        const Triangle& t = triangles_[i];
+        if (segment_hits_triangle(x, p, s_min, s_max, t.v[0], t.v[1], t.v[2])) return true;
+      }
+      continue;
+    }
+    const Node& node = nodes_[code];
+    for (int slot = 0; slot < 4; ++slot) {
+      if (std::isnan(node.bounds[0][0][slot])) continue;
+      // Slab test of the parameter range [0, 1] of x + s (p - x).
+      double enter = 0, exit = 1;
+      for (int k = 0; k < 3 && enter <= exit; ++k) {
+        double lower = node.bounds[0][k][slot] - pad, upper = node.bounds[1][k][slot] + pad;
+        if (direction[k] == 0) {
+          if (x[k] < lower || x[k] > upper) exit = -1;
+          continue;
+        }
+        double s0 = (lower - x[k]) / direction[k], s1 = (upper - x[k]) / direction[k];
+        enter = std::max(enter, std::min(s0, s1));
+        exit = std::min(exit, std::max(s0, s1));
+      }
+      if (enter <= exit) stack[top++] = node.child[slot];
+    }
+  }
+  return false;
+}
+
+}  // namespace penumbra

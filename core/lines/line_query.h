@@ -1,0 +1,94 @@
+#pragma once
+// The shadow-triangle query of line sampling (Billen & Dutré 2016 Sec. 5.2; Salesin & Jarosz
+// 2019 Sec. 4): which parts of a segment a->b on a light are visible from a shading point x.
+// It is the cost centre of line sampling, so it has its own acceleration structure:
+//
+// - a 4-wide BVH (BVH4) built by Embree's rtcBuildBVH (SAH, MEDIUM quality by default) through
+//   our own node callbacks, then flattened into one array of nodes with float boxes stored
+//   structure-of-arrays, and leaf triangles stored inline in double, vertices in canonical order;
+// - our own traversal: the four child boxes of a node are tested together (SSE) against the
+//   shadow triangle's plane, its three side planes and the self-occlusion plane near x, with a
+//   conservative float error bound; each surviving child's box is projected from x onto the
+//   segment and skipped when that t-range is already occluded (checked again when it is
+//   popped); children are visited nearest to x first (near occluders cut the most); the query
+//   stops as soon as nothing stays visible;
+// - exact double-precision crossings at the leaves (core/lines/shadow_triangle.h), watertight
+//   at shared edges, so the result equals visible_intervals_brute_force.
+//
+// Thread safety: a built LineQuery is immutable; queries from many threads are fine.
+
+#include <cstdint>
+#include <vector>
+
+#include "core/lines/intervals.h"
+#include "core/lines/shadow_triangle.h"
+#include "core/math/vec.h"
+
+namespace penumbra {
+
+struct Scene;
+
+enum class LineQueryBuildQuality { Low, Medium, High };
+
+struct LineQueryOptions {
+  ShadowTriangleTolerances tolerances;
+  // Embree's SAH builder quality. HIGH runs without spatial splits (no split callback).
+  LineQueryBuildQuality build_quality = LineQueryBuildQuality::Medium;
+  unsigned max_leaf_size = 4;  // triangles per leaf
+};
+
+// Counters of one or more queries (for benchmarks and tests of the culling).
+struct LineQueryStats {
+  uint64_t nodes_visited = 0;     // inner nodes whose four children were tested
+  uint64_t triangles_tested = 0;  // exact occluder_cut calls
+  uint64_t cuts = 0;              // cuts subtracted
+};
+
+class LineQuery {
+ public:
+  // Builds from flat triangle arrays (3 indices per triangle into `positions`). Triangles of
+  // zero area or with non-finite coordinates are dropped: they cannot occlude.
+  LineQuery(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices,
+            const LineQueryOptions& options = {});
+  // Builds from a scene's occluder triangles (lights are not among them: they never occlude).
+  explicit LineQuery(const Scene& scene, const LineQueryOptions& options = {});
+
+  // The visible sub-intervals of t in [0,1] of the segment a + t (b - a) as seen from x. Every
+  // occluder triangle crossing the shadow triangle (x, a, b) strictly between x and the segment
+  // removes the interval its crossing projects to. Degenerate shadow triangles (a == b, x on
+  // the segment's line) are answered with one shadow ray to the midpoint: all or nothing.
+  // Non-finite input: nothing visible. `stats`, when given, is incremented.
+  void visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, IntervalList& out,
+                         LineQueryStats* stats = nullptr) const;
+
+  // True when an occluder blocks the segment x->p, with the same tolerances as line queries
+  // (a shadow ray through this structure).
+  bool occluded(const Vec3& x, const Vec3& p) const;
+
+  size_t triangle_count() const { return triangles_.size(); }
+  size_t node_count() const { return nodes_.size(); }
+  const LineQueryOptions& options() const { return options_; }
+
+  // One BVH4 node: the boxes of its four children, structure-of-arrays so one SSE register
+  // holds one coordinate of all four. Empty slots have NaN boxes (every test rejects them).
+  struct alignas(64) Node {
+    float bounds[2][3][4];  // [lower/upper][axis][child]
+    uint32_t child[4];      // inner node index, or kLeafFlag | first << kCountBits | count - 1
+  };
+  // A leaf triangle: vertices in canonical order (order_canonically).
+  struct Triangle {
+    Vec3 v[3];
+  };
+  static constexpr uint32_t kLeafFlag = 0x80000000u;
+  static constexpr uint32_t kCountBits = 5;  // up to 32 triangles per leaf
+
+ private:
+  void build(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices);
+
+  LineQueryOptions options_;
+  std::vector<Node> nodes_;  // nodes_[0] is the root
+  std::vector<Triangle> triangles_;
+  Vec3 scene_max_abs_;  // per axis, the largest |coordinate| (float error bounds)
+};
+
+}  // namespace penumbra
