@@ -244,8 +244,10 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
     for (size_t s = 0; s < spec.series.size(); ++s) {
       const ChartSeries& series = spec.series[s];
       const PlottedSeries& p = plotted_series[s];
-      int color = kFirstSeriesColor + int(s % kPaletteSize);
-      const char* marker = kMarkers[s % kMarkerCount];
+      size_t palette_index = series.color >= 0 ? size_t(series.color) : s;
+      int color = kFirstSeriesColor + int(palette_index % kPaletteSize);
+      const char* marker = kMarkers[palette_index % kMarkerCount];
+      int line_style = series.dashed ? kDashedLine : kSolidLine;
       pls.col0(color);
       pls.width(1.5);
       pls.lsty(kSolidLine);
@@ -255,7 +257,11 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
           if (std::isnan(v)) v = y_axis.low;
         pls.erry(PLINT(p.x.size()), p.x.data(), low.data(), p.error_high.data());
       }
-      if (series.lines && p.x.size() >= 2) pls.line(PLINT(p.x.size()), p.x.data(), p.y.data());
+      if (series.lines && p.x.size() >= 2) {
+        pls.lsty(line_style);
+        pls.line(PLINT(p.x.size()), p.x.data(), p.y.data());
+        pls.lsty(kSolidLine);
+      }
       if (series.markers && !p.x.empty())
         pls.string(PLINT(p.x.size()), p.x.data(), p.y.data(), marker);
 
@@ -266,7 +272,7 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
       legend_options.push_back(option);
       legend_texts.push_back(plplot_text(series.name));
       legend_colors.push_back(color);
-      legend_styles.push_back(kSolidLine);
+      legend_styles.push_back(line_style);
       legend_symbols.push_back(marker);
 
       if (!p.fit_x.empty()) {

@@ -24,6 +24,8 @@ struct ChartSeries {
   std::optional<LineFit> fit;
   bool markers = true;  // draw a symbol at each point
   bool lines = true;    // connect the points
+  bool dashed = false;  // draw the connecting line dashed (e.g. a predicted curve)
+  int color = -1;       // palette index (cycled); -1: the series' position in the chart
 };
 
 struct ChartSpec {
