@@ -27,4 +27,12 @@ std::optional<LightHit> intersect_light(const Light& light, const Vec3& origin,
 // True when `point` lies on the light (within a scale-relative tolerance).
 bool light_contains(const Light& light, const Vec3& point);
 
+// Signed distance of `point` from the light's plane, positive on the emitting side.
+double light_plane_height(const Light& light, const Vec3& point);
+
+// True when `point` is strictly on the emitting side of the light's plane, farther than a
+// tolerance relative to the light's size and the point's distance (1e-12). A point on the plane
+// or behind it receives nothing from the light; strategies give no sample there.
+bool light_faces_point(const Light& light, const Vec3& point);
+
 }  // namespace penumbra
