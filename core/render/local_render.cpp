@@ -1,0 +1,60 @@
+#include "core/render/local_render.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <ctime>
+#include <stdexcept>
+
+namespace penumbra {
+
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + ts.tv_nsec * 1e-9;
+}
+
+LocalRenderResult render_local(const Renderer& renderer, const RenderBudget& budget, int threads,
+                               int tile_size,
+                               const std::function<void(uint32_t, double)>& progress) {
+  if (budget.spp == 0 && !(budget.seconds > 0))
+    throw std::invalid_argument("a render needs a budget: spp >= 1 or seconds > 0");
+  const Camera& camera = renderer.scene().camera;
+  LocalRenderResult result;
+  std::vector<TileRect> rects = cut_tiles(camera.width, camera.height, tile_size);
+  for (const TileRect& r : rects) result.tiles.emplace_back(r);
+
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  const double cpu_start = process_cpu_seconds();
+  const auto wall_start = std::chrono::steady_clock::now();
+  uint32_t done = 0;
+  uint32_t block = 1;
+  while (true) {
+    uint32_t target = budget.spp > 0 ? budget.spp : std::min(budget.max_spp, done + block);
+    if (target <= done) break;
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), rects.size(), [&](size_t t) {
+        renderer.render_tile(rects[t], done, target, result.tiles[t]);
+      });
+    });
+    done = target;
+    double spent = process_cpu_seconds() - cpu_start;
+    if (progress) progress(done, spent);
+    if (budget.spp > 0 || done >= budget.max_spp) break;
+    // Pass blocks grow so the time check costs nothing, but never overshoot the budget much:
+    // the next block is sized from the cost per pass so far.
+    double per_pass = spent / done;
+    if (spent + per_pass >= budget.seconds) break;
+    double remaining_passes = (budget.seconds - spent) / std::max(per_pass, 1e-9);
+    block = uint32_t(std::clamp(remaining_passes / 2, 1.0, double(std::max<uint32_t>(1, done))));
+  }
+  result.spp = done;
+  result.compute_seconds = process_cpu_seconds() - cpu_start;
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  result.film = assemble_film(camera.width, camera.height, result.tiles);
+  return result;
+}
+
+}  // namespace penumbra

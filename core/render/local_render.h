@@ -1,0 +1,35 @@
+#pragma once
+// A whole image rendered in this process: by samples per pixel, or progressively until a
+// compute-time budget is spent (stopping at a pass boundary, so every pixel has the same spp and
+// the image is unbiased). The farm renders the same passes of the same tiles.
+
+#include <functional>
+
+#include "core/render/film.h"
+#include "core/render/renderer.h"
+
+namespace penumbra {
+
+struct RenderBudget {
+  uint32_t spp = 0;        // render exactly this many passes, or
+  double seconds = 0;      // pass blocks until this much compute (CPU) time is spent
+  uint32_t max_spp = 1u << 20;
+};
+
+struct LocalRenderResult {
+  Film film;
+  std::vector<TileAccumulator> tiles;
+  uint32_t spp = 0;
+  double compute_seconds = 0;  // CPU seconds of all threads
+  double wall_seconds = 0;
+};
+
+// Progress is called after every pass block with the passes done and compute seconds so far.
+LocalRenderResult render_local(const Renderer& renderer, const RenderBudget& budget, int threads,
+                               int tile_size = 64,
+                               const std::function<void(uint32_t, double)>& progress = {});
+
+// CPU time of the process (all threads), seconds.
+double process_cpu_seconds();
+
+}  // namespace penumbra
