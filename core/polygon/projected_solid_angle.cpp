@@ -1,0 +1,452 @@
+#include "core/polygon/projected_solid_angle.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace penumbra {
+
+namespace {
+
+// Small 2D helpers (Vec2 carries no arithmetic in core/math/vec.h).
+Vec2 xy(const Vec3& v) {
+  return {v.x, v.y};
+}
+Vec2 add2(const Vec2& a, const Vec2& b) {
+  return {a.x + b.x, a.y + b.y};
+}
+Vec2 sub2(const Vec2& a, const Vec2& b) {
+  return {a.x - b.x, a.y - b.y};
+}
+Vec2 scale2(const Vec2& a, double s) {
+  return {a.x * s, a.y * s};
+}
+double dot2(const Vec2& a, const Vec2& b) {
+  return a.x * b.x + a.y * b.y;
+}
+// z of the 3D cross product, with Kahan's algorithm so that its sign is right (Sec. 3.7).
+double cross2(const Vec2& a, const Vec2& b) {
+  return difference_of_products(a.x, b.y, a.y, b.x);
+}
+// Peters' R: rotation by 90 degrees counter-clockwise.
+Vec2 rotate90(const Vec2& a) {
+  return {-a.y, a.x};
+}
+Vec2 normalize2(const Vec2& a) {
+  double l = std::sqrt(dot2(a, a));
+  return l > 0 ? scale2(a, 1.0 / l) : a;
+}
+
+using Mat2 = std::array<double, 4>;  // row-major {xx, xy, yx, yy}
+Mat2 outer_product(const Vec2& a, const Vec2& b) {
+  return {a.x * b.x, a.x * b.y, a.y * b.x, a.y * b.y};
+}
+Mat2 subtract(const Mat2& a, const Mat2& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]};
+}
+
+// C w with C = c^2 I + m m^T.
+Vec2 apply_ellipse(const EdgeEllipse& e, const Vec2& w) {
+  double mw = dot2(e.m, w);
+  return {e.c * e.c * w.x + e.m.x * mw, e.c * e.c * w.y + e.m.y * mw};
+}
+// a^T C b.
+double ellipse_form(const EdgeEllipse& e, const Vec2& a, const Vec2& b) {
+  return e.c * e.c * dot2(a, b) + dot2(e.m, a) * dot2(e.m, b);
+}
+
+// Bisector of the unit directions a and b (at most 180 degrees apart, counter-clockwise from a):
+// their sum (Peters Eq. 8), or near 180 degrees the rotated difference, the stable form there.
+Vec2 bisector(const Vec2& a, const Vec2& b) {
+  return normalize2(dot2(a, b) >= 0 ? add2(a, b) : Vec2{b.y - a.y, a.x - b.x});
+}
+
+// w is a non-zero finite direction in the sector from low to high (counter-clockwise).
+bool inside_bracket(const Vec2& low, const Vec2& w, const Vec2& high) {
+  double l2 = dot2(w, w);
+  return l2 > 0 && std::isfinite(l2) && cross2(low, w) >= 0 && cross2(w, high) >= 0;
+}
+
+// dot(N, v0) for the polygon's area vector N: its sign is that of det(v0, v1, v2) for consecutive
+// vertices of a planar convex polygon, 0 when the origin lies in the polygon's plane. Formed from
+// edge vectors to stay accurate for tiny, distant polygons.
+double plane_offset(std::span<const Vec3> v) {
+  Vec3 area_vector;
+  for (size_t i = 1; i + 1 < v.size(); ++i)
+    area_vector += cross_accurate(v[i] - v[0], v[i + 1] - v[0]);
+  return dot(area_vector, v[0]);
+}
+
+// |c| below this is treated as a great circle through the zenith: c^2 would underflow.
+constexpr double kZenithCircleC = 1e-140;
+
+}  // namespace
+
+EdgeEllipse edge_ellipse(const Vec3& a, const Vec3& b) {
+  Vec3 n = cross_accurate(a, b);
+  double l = length(n);
+  EdgeEllipse e;
+  if (!(l > 0) || !std::isfinite(l)) return e;  // a and b in the same direction: no arc
+  e.c = n.z / l;
+  e.m = {n.x / l, n.y / l};
+  if (std::abs(e.c) < kZenithCircleC) e.c = 0;
+  return e;
+}
+
+double ellipse_sector_area(const EdgeEllipse& e, const Vec2& s0, const Vec2& w) {
+  double abs_c = std::abs(e.c);
+  if (abs_c == 0) return 0.0;
+  return 0.5 * abs_c * std::atan2(abs_c * cross2(s0, w), ellipse_form(e, s0, w));
+}
+
+double ellipse_radius_squared(const EdgeEllipse& e, const Vec2& w) {
+  double denominator = ellipse_form(e, w, w);
+  return denominator > 0 ? std::min(1.0, e.c * e.c * dot2(w, w) / denominator) : 0.0;
+}
+
+double ellipse_one_minus_radius_squared(const EdgeEllipse& e, const Vec2& w) {
+  double denominator = ellipse_form(e, w, w);
+  double mw = dot2(e.m, w);
+  return denominator > 0 ? std::min(1.0, mw * mw / denominator) : 1.0;
+}
+
+int clip_polygon_to_upper_hemisphere(std::span<const Vec3> vertices, std::span<Vec3> out) {
+  int n = static_cast<int>(vertices.size());
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    const Vec3& a = vertices[i];
+    const Vec3& b = vertices[(i + 1) % n];
+    if (a.z >= 0) out[count++] = a;
+    // Strict crossings only: a vertex on the horizon is kept once, as itself.
+    if ((a.z > 0 && b.z < 0) || (a.z < 0 && b.z > 0)) {
+      double t = a.z / (a.z - b.z);
+      Vec3 p = a + (b - a) * t;
+      p.z = 0;
+      out[count++] = p;
+    }
+  }
+  return count < 3 ? 0 : count;
+}
+
+double projected_solid_angle(std::span<const Vec3> vertices_local) {
+  int n = static_cast<int>(vertices_local.size());
+  if (n < 3 || n > kMaxPolygonVertices) return 0.0;
+  // Seen edge-on (the shading point in the polygon's plane): no projected solid angle.
+  if (!(plane_offset(vertices_local) != 0)) return 0.0;
+  std::array<Vec3, kMaxClippedPolygonVertices> clipped;
+  int m = clip_polygon_to_upper_hemisphere(vertices_local, clipped);
+  // Lambert's formula: each edge contributes the projected solid angle of the spherical triangle
+  // (zenith, v_j, v_{j+1}).
+  double sum = 0;
+  for (int j = 0; j < m; ++j) {
+    const Vec3& a = clipped[j];
+    const Vec3& b = clipped[(j + 1) % m];
+    Vec3 normal = cross_accurate(a, b);
+    double l = length(normal);
+    if (!(l > 0)) continue;
+    sum += normal.z / l * std::atan2(l, dot(a, b));
+  }
+  double result = 0.5 * std::abs(sum);
+  return std::isfinite(result) ? result : 0.0;
+}
+
+Vec2 solve_homogeneous_quadratic(const Mat2& t) {
+  // w^T T w = t_xx w_x^2 + (t_xy + t_yx) w_x w_y + t_yy w_y^2 = 0 (Peters Eq. 6).
+  double half_b = 0.5 * (t[1] + t[2]);
+  double root = safe_sqrt(difference_of_products(half_b, half_b, t[0], t[3]));
+  if (half_b >= 0) return {half_b + root, -t[0]};
+  return {t[3], -half_b + root};
+}
+
+ProjectedSolidAngleSampler::ProjectedSolidAngleSampler(std::span<const Vec3> vertices_local,
+                                                       int iterations)
+    : iterations_(iterations) {
+  int n = static_cast<int>(vertices_local.size());
+  if (n < 3 || n > kMaxPolygonVertices) return;
+
+  // Orientation: the projection is counter-clockwise (seen from +z) iff det(v0, v1, v2) > 0 for
+  // consecutive vertices, i.e. iff the plane offset is positive.
+  double offset = plane_offset(vertices_local);
+  if (!(offset != 0) || !std::isfinite(offset)) return;  // seen edge-on, or not finite
+
+  // Clip the polygon at the horizon (Sec. 3.1).
+  std::array<Vec3, kMaxClippedPolygonVertices> clipped;
+  int m = clip_polygon_to_upper_hemisphere(vertices_local, clipped);
+  if (m == 0) return;
+  if (offset < 0) std::reverse(clipped.begin(), clipped.begin() + m);
+
+  // Drop vertices in the same direction as their predecessor (a vertex on the horizon that
+  // clipping repeated, or a zero-length edge): they would give edges without a great circle.
+  std::array<Vec3, kMaxClippedPolygonVertices> v;
+  int count = 0;
+  for (int i = 0; i < m; ++i) {
+    if (count > 0) {
+      const Vec3& previous = v[count - 1];
+      if (cross_accurate(previous, clipped[i]) == Vec3{} && dot(previous, clipped[i]) > 0) continue;
+    }
+    v[count++] = clipped[i];
+  }
+  while (count > 1 && cross_accurate(v[count - 1], v[0]) == Vec3{} && dot(v[count - 1], v[0]) > 0)
+    --count;
+  if (count < 3) return;
+  m = count;
+
+  std::array<EdgeEllipse, kMaxClippedPolygonVertices> ellipses;
+  bool has_inner = false;
+  for (int j = 0; j < m; ++j) {
+    ellipses[j] = edge_ellipse(v[j], v[(j + 1) % m]);
+    has_inner = has_inner || ellipses[j].c < 0;
+  }
+
+  if (!has_inner) {
+    // Central case (Fig. 3a): one sector per edge, bounded by that edge's ellipse alone. Edges
+    // through the zenith (c == 0) give empty sectors.
+    central_ = true;
+    for (int j = 0; j < m; ++j)
+      add_sector(xy(v[j]), xy(v[(j + 1) % m]), EdgeEllipse{}, ellipses[j]);
+  } else {
+    // Decentral case (Fig. 3b): edges with c > 0 run counter-clockwise in azimuth and form the
+    // outer chain, the others (c <= 0) run back and form the inner chain. Both chains go from
+    // the clockwise end of the polygon to its counter-clockwise end; merging their vertices by
+    // azimuth gives the sectors, each with one inner and one outer ellipse (Sec. 3.7).
+    int start = 0;
+    for (int j = 0; j < m; ++j) {
+      if (ellipses[j].c > 0 && ellipses[(j + m - 1) % m].c <= 0) {
+        start = j;
+        break;
+      }
+    }
+    int outer_count = 0;  // edges in the outer chain
+    while (outer_count < m && ellipses[(start + outer_count) % m].c > 0) ++outer_count;
+    int inner_count = m - outer_count;
+    auto outer_vertex = [&](int a) { return xy(v[(start + a) % m]); };
+    auto inner_vertex = [&](int b) { return xy(v[(start - b + m) % m]); };
+    auto outer_edge = [&](int a) { return ellipses[(start + a) % m]; };
+    auto inner_edge = [&](int b) { return ellipses[(start - b - 1 + m) % m]; };
+    int a = 0, b = 0;
+    Vec2 s0 = outer_vertex(0);
+    while (a < outer_count || b < inner_count) {
+      bool take_outer;
+      if (a == outer_count)
+        take_outer = false;
+      else if (b == inner_count)
+        take_outer = true;
+      else
+        take_outer = cross2(outer_vertex(a + 1), inner_vertex(b + 1)) >= 0;
+      Vec2 s1 = take_outer ? outer_vertex(a + 1) : inner_vertex(b + 1);
+      add_sector(s0, s1, inner_edge(std::min(b, inner_count - 1)),
+                 outer_edge(std::min(a, outer_count - 1)));
+      if (take_outer)
+        ++a;
+      else
+        ++b;
+      s0 = s1;
+    }
+  }
+  if (!(total_area_ > 0) || !std::isfinite(total_area_)) {
+    total_area_ = 0;
+    sector_count_ = 0;
+  }
+}
+
+void ProjectedSolidAngleSampler::add_sector(const Vec2& s0, const Vec2& s1,
+                                            const EdgeEllipse& inner, const EdgeEllipse& outer) {
+  Sector& s = sectors_[sector_count_++];
+  s.s0 = s0;
+  s.s1 = s1;
+  s.inner = inner;
+  s.outer = outer;
+  // Sector areas by Peters Eq. 1; the difference of outer and inner in the decentral case.
+  double area = area_up_to(s, s1);
+  s.area = std::isfinite(area) ? std::max(0.0, area) : 0.0;
+  double abs_c = std::abs(outer.c);
+  s.angle = std::max(0.0, std::atan2(abs_c * cross2(s0, s1), ellipse_form(outer, s0, s1)));
+  total_area_ += s.area;
+}
+
+double ProjectedSolidAngleSampler::area_up_to(const Sector& s, const Vec2& w) const {
+  double area = ellipse_sector_area(s.outer, s.s0, w);
+  if (s.inner.c != 0) area -= ellipse_sector_area(s.inner, s.s0, w);
+  return area;
+}
+
+int ProjectedSolidAngleSampler::select_sector(double u0, double* area_in_sector) const {
+  double target = u0 * total_area_;
+  double before = 0;
+  int chosen = -1;
+  for (int i = 0; i < sector_count_; ++i) {
+    if (!(sectors_[i].area > 0)) continue;
+    chosen = i;
+    if (target < before + sectors_[i].area) break;
+    before += sectors_[i].area;
+  }
+  if (chosen < 0) return -1;
+  // The last sector also absorbs rounding in the running sum.
+  if (target >= before + sectors_[chosen].area) before = total_area_ - sectors_[chosen].area;
+  *area_in_sector = std::clamp(target - before, 0.0, sectors_[chosen].area);
+  return chosen;
+}
+
+Vec2 ProjectedSolidAngleSampler::single_ellipse_direction(const Sector& s, double area) const {
+  // Central case (Sec. 3.2): the linear map that takes the ellipse to a unit circle turns the
+  // sector area into an angle, alpha = angle * area / sector area. Solving Peters' 2x2 system
+  //   (|c| cross(s0, w), s0^T C w) ~ (sin alpha, cos alpha)
+  // gives w = |c| cos(alpha) s0 + sin(alpha) R C s0.
+  double alpha = s.area > 0 ? s.angle * std::clamp(area / s.area, 0.0, 1.0) : 0.0;
+  Vec2 c_s0 = apply_ellipse(s.outer, s.s0);
+  return add2(scale2(s.s0, std::abs(s.outer.c) * std::cos(alpha)),
+              scale2(rotate90(c_s0), std::sin(alpha)));
+}
+
+Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double area) const {
+  const EdgeEllipse& inner = s.inner;
+  const EdgeEllipse& outer = s.outer;
+  Vec2 s0 = normalize2(s.s0), s1 = normalize2(s.s1);
+  Vec2 half = bisector(s0, s1);
+
+  // Two-quad initialization (Sec. 3.4): the points where the rays through s0, s_h and s1 meet
+  // the inner and outer ellipses span two quads; the quad that holds the area is sampled
+  // uniformly (area rescaled from the sector to the quads).
+  auto on_ellipse = [](const EdgeEllipse& e, const Vec2& direction) {
+    return scale2(direction, std::sqrt(ellipse_radius_squared(e, direction)));
+  };
+  Vec2 inner0 = on_ellipse(inner, s0), inner_half = on_ellipse(inner, half),
+       inner1 = on_ellipse(inner, s1);
+  Vec2 outer0 = on_ellipse(outer, s0), outer_half = on_ellipse(outer, half),
+       outer1 = on_ellipse(outer, s1);
+  double quad0 = 0.5 * (cross2(outer0, outer_half) - cross2(inner0, inner_half));
+  double quad1 = 0.5 * (cross2(outer_half, outer1) - cross2(inner_half, inner1));
+  double quads = quad0 + quad1;
+  double quad_area = (s.area > 0 && quads > 0) ? area * (quads / s.area) : 0.0;
+  bool second = quad_area > quad0;
+  // Measured from s1, clockwise: a negative signed area.
+  if (second) quad_area -= quads;
+  Vec2 inner_k = second ? inner1 : inner0;
+  Vec2 outer_k = second ? outer1 : outer0;
+  // Quad edges r_l^T q = D_l (Peters Supplement A.4, scaled by c_l^2): r_l = C (p_h + p_k),
+  // D_l = p_h^T r_l.
+  Vec2 r_inner = apply_ellipse(inner, add2(inner_half, inner_k));
+  Vec2 r_outer = apply_ellipse(outer, add2(outer_half, outer_k));
+  double d_inner = dot2(inner_half, r_inner);
+  double d_outer = dot2(outer_half, r_outer);
+  // Q = D_o R p_ok r_i^T - (D_i R p_ik + 2 A_q r_i) r_o^T.
+  Mat2 q = subtract(
+      outer_product(scale2(rotate90(outer_k), d_outer), r_inner),
+      outer_product(add2(scale2(rotate90(inner_k), d_inner), scale2(r_inner, 2.0 * quad_area)),
+                    r_outer));
+  Vec2 w = solve_homogeneous_quadratic(q);
+  if (dot2(w, half) < 0) w = scale2(w, -1.0);
+  // Safeguard (ours, not in the paper): the area up to w grows monotonically with the angle, so
+  // the residual's sign tells on which side of w the answer lies. An iterate that leaves the
+  // sector (or is not finite) is replaced by the bisector of the bracket those signs give. This
+  // only acts where rounding swamps the area: slivers of ~1e-17 sr at the horizon or seen
+  // nearly edge-on, where tangent lines become parallel (Sec. 3.5).
+  Vec2 low = s0, high = s1;
+  if (!inside_bracket(s0, w, s1)) w = half;
+
+  // Tangent-line iteration (Sec. 3.3): replace both ellipses by their tangents at the current
+  // direction w_n and find w_{n+1} such that the area between the tangents in the sector
+  // (w_n, w_{n+1}) is the residual A_delta (Eq. 7). In the scaled form (C_l -> c_l^2 C_l) the
+  // condition is w^T T w = 0 with (Eq. 5)
+  //   T = R w_n g^T - 2 A_delta p q^T,  g = c_o^2 C_i w_n - c_i^2 C_o w_n,  p = C_o w_n,
+  //   q = C_i w_n.
+  // Instead of Peters' Eq. 6 we solve it for the step t in w = w_n + t R w_n:
+  //   a0 + a1 t + a2 t^2 = 0,  a0 = -2 A_delta (p.w_n)(q.w_n),
+  //   a1 = g.w_n - 2 A_delta ((p.w_n)(q.e) + (p.e)(q.w_n)),  a2 = g.e - 2 A_delta (p.e)(q.e),
+  // with e = R w_n, taking the root that vanishes with A_delta (the one Eq. 6 selects). The
+  // reason is precision: in thin slivers (inner and outer ellipse nearly equal; a small light
+  // seen at a grazing angle) the two roots of Eq. 5 nearly coincide and Eq. 6's discriminant
+  // cancels, leaving ~1e-5 backward errors in double; the step form keeps full precision.
+  double co2 = outer.c * outer.c, ci2 = inner.c * inner.c;
+  double converged = 1e-13 * s.area;
+  for (int iteration = 0; iteration < iterations_; ++iteration) {
+    Vec2 wn = normalize2(w);
+    double residual = area - area_up_to(s, wn);
+    // Converged to rounding level: further steps would only move w by rounding noise.
+    if (std::abs(residual) <= converged) break;
+    if (residual > 0)
+      low = wn;
+    else
+      high = wn;
+    Vec2 e = rotate90(wn);
+    Vec2 p = apply_ellipse(outer, wn), q = apply_ellipse(inner, wn);
+    Vec2 g = sub2(scale2(q, co2), scale2(p, ci2));
+    double pw = dot2(p, wn), qw = dot2(q, wn), pe = dot2(p, e), qe = dot2(q, e);
+    double a0 = -2.0 * residual * pw * qw;
+    double a1 = dot2(g, wn) - 2.0 * residual * (pw * qe + pe * qw);
+    double a2 = dot2(g, e) - 2.0 * residual * pe * qe;
+    double root = safe_sqrt(difference_of_products(a1, a1, 4.0 * a0, a2));
+    double denominator = a1 + std::copysign(root, a1);
+    Vec2 next = add2(wn, scale2(e, denominator != 0 ? -2.0 * a0 / denominator : 0.0));
+    // A step that leaves the sector (or is not finite) is replaced by bisection.
+    w = inside_bracket(s0, next, s1) ? next : bisector(normalize2(low), normalize2(high));
+  }
+  return w;
+}
+
+std::optional<Vec3> ProjectedSolidAngleSampler::sample(const Vec2& u) const {
+  double area = 0;
+  int index = select_sector(u.x, &area);
+  if (index < 0) return std::nullopt;
+  const Sector& s = sectors_[index];
+  bool single = s.inner.c == 0;
+  Vec2 w = single ? single_ellipse_direction(s, area) : two_ellipse_direction(s, area);
+  // Radius: rho^2 uniform between the inner and outer ellipse (Sec. 3.3), z from 1 - rho^2
+  // formed without cancellation (Eq. 2).
+  double inner_r2 = single ? 0.0 : ellipse_radius_squared(s.inner, w);
+  double inner_z2 = single ? 1.0 : ellipse_one_minus_radius_squared(s.inner, w);
+  double outer_r2 = ellipse_radius_squared(s.outer, w);
+  double outer_z2 = ellipse_one_minus_radius_squared(s.outer, w);
+  double rho2 = (1.0 - u.y) * inner_r2 + u.y * outer_r2;
+  double z2 = (1.0 - u.y) * inner_z2 + u.y * outer_z2;
+  Vec2 w_unit = normalize2(w);
+  double rho = std::sqrt(std::max(0.0, rho2));
+  Vec3 direction{rho * w_unit.x, rho * w_unit.y, std::sqrt(std::max(0.0, z2))};
+  double l = length(direction);
+  if (!(l > 0) || !std::isfinite(l)) return std::nullopt;
+  return direction / l;
+}
+
+std::optional<Vec2> ProjectedSolidAngleSampler::invert(const Vec3& direction) const {
+  if (!(total_area_ > 0) || !(direction.z >= 0)) return std::nullopt;
+  double l2 = length_squared(direction);
+  if (!(l2 > 0)) return std::nullopt;
+  Vec2 w = xy(direction);
+  double rho2 = dot2(w, w) / l2;
+  double before = 0;
+  for (int i = 0; i < sector_count_; ++i) {
+    const Sector& s = sectors_[i];
+    if (!(s.area > 0)) continue;
+    bool inside =
+        (rho2 == 0 && central_) || (cross2(s.s0, w) >= 0 && cross2(w, s.s1) >= 0 &&
+                                    dot2(w, add2(normalize2(s.s0), normalize2(s.s1))) >= 0);
+    if (!inside) {
+      before += s.area;
+      continue;
+    }
+    bool single = s.inner.c == 0;
+    double area = rho2 == 0 ? 0.0 : std::clamp(area_up_to(s, w), 0.0, s.area);
+    double inner_r2 = single ? 0.0 : ellipse_radius_squared(s.inner, w);
+    double outer_r2 = rho2 == 0 ? 1.0 : ellipse_radius_squared(s.outer, w);
+    double u1 = outer_r2 > inner_r2 ? (rho2 - inner_r2) / (outer_r2 - inner_r2) : 0.0;
+    return Vec2{std::clamp((before + area) / total_area_, 0.0, 1.0), std::clamp(u1, 0.0, 1.0)};
+  }
+  return std::nullopt;
+}
+
+double ProjectedSolidAngleSampler::area_cancellation(double u0) const {
+  double area = 0;
+  int index = select_sector(u0, &area);
+  if (index < 0) return 1.0;
+  const Sector& s = sectors_[index];
+  return std::abs(ellipse_sector_area(s.outer, s.s0, s.s1)) / s.area;
+}
+
+double ProjectedSolidAngleSampler::backward_error(const Vec2& u, const Vec3& direction) const {
+  double area = 0;
+  int index = select_sector(u.x, &area);
+  if (index < 0) return 0.0;
+  const Sector& s = sectors_[index];
+  return std::abs(area - area_up_to(s, xy(direction))) / s.area;
+}
+
+}  // namespace penumbra
