@@ -41,6 +41,7 @@ enum class ExrPixelType { Float, Half };
 void write_exr(const std::string& path, const Image& color, const Image* variance,
                const ImageMetadata& metadata, ExrPixelType pixel_type = ExrPixelType::Float);
 // The same EXR as bytes (for the farm's result stream), encoded in memory (no temporary file).
+// write_exr writes exactly these bytes, atomically (a temporary file beside `path`, renamed).
 std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata,
                        ExrPixelType pixel_type = ExrPixelType::Float);
 // Reads R,G,B (and metadata when asked: every "penumbra:" string attribute, keys with the

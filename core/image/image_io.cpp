@@ -3,14 +3,22 @@
 // Precision: pixels are float in memory. EXR channels are written as float (bit-exact round
 // trip) or half (half the bytes, ~3 decimal digits) as the caller asks; every channel of one file
 // has the same type. In-memory encoding uses OIIO's IOVecOutput / IOMemReader proxies: the
-// OpenEXR plugin of OIIO 2.4 supports them, so no temporary file is ever written.
+// OpenEXR plugin of OIIO 2.4 supports them, so encode/decode never touch the disk. write_exr
+// encodes in memory too, then writes the file atomically (temporary file + rename).
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -173,18 +181,11 @@ double srgb_encode(double linear) {
 
 }  // namespace
 
-void write_exr(const std::string& path, const Image& color, const Image* variance,
-               const ImageMetadata& metadata, ExrPixelType pixel_type) {
-  std::string where = "EXR '" + path + "'";
-  ExrContents contents = exr_contents(color, variance, metadata, pixel_type, where);
-  auto output = oiio::ImageOutput::create("openexr");
-  if (!output) throw std::runtime_error(where + ": no OpenEXR writer: " + oiio::geterror());
-  write_contents(*output, path, contents, where);
-}
+namespace {
 
-std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata,
-                       ExrPixelType pixel_type) {
-  std::string where = "EXR encoding";
+// Encodes to memory; `where` names the destination in errors.
+std::string encode_exr_for(const std::string& where, const Image& color, const Image* variance,
+                           const ImageMetadata& metadata, ExrPixelType pixel_type) {
   ExrContents contents = exr_contents(color, variance, metadata, pixel_type, where);
   std::vector<unsigned char> bytes;
   oiio::Filesystem::IOVecOutput proxy(bytes);
@@ -194,6 +195,46 @@ std::string encode_exr(const Image& color, const Image* variance, const ImageMet
     throw std::runtime_error(where + ": this OpenImageIO's OpenEXR writer cannot write to memory");
   write_contents(*output, "memory.exr", contents, where);
   return std::string(bytes.begin(), bytes.end());
+}
+
+// Writes the bytes to a temporary file beside `path`, then renames it over `path`: a reader (or a
+// coordinator restarted after a crash) sees the old file or the complete new one, never a part.
+void write_file_atomically(const std::string& path, const std::string& bytes,
+                           const std::string& where) {
+  static std::atomic<uint64_t> counter{0};
+  std::string temporary =
+      path + ".partial-" + std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+  {
+    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
+    if (!file)
+      throw std::runtime_error(where + ": cannot open for writing: " + std::strerror(errno));
+    file.write(bytes.data(), std::streamsize(bytes.size()));
+    file.close();
+    if (!file) {
+      std::remove(temporary.c_str());
+      throw std::runtime_error(where + ": cannot write " + std::to_string(bytes.size()) + " bytes");
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::remove(temporary.c_str());
+    throw std::runtime_error(where +
+                             ": cannot move the finished file into place: " + error.message());
+  }
+}
+
+}  // namespace
+
+void write_exr(const std::string& path, const Image& color, const Image* variance,
+               const ImageMetadata& metadata, ExrPixelType pixel_type) {
+  std::string where = "EXR '" + path + "'";
+  write_file_atomically(path, encode_exr_for(where, color, variance, metadata, pixel_type), where);
+}
+
+std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata,
+                       ExrPixelType pixel_type) {
+  return encode_exr_for("EXR encoding", color, variance, metadata, pixel_type);
 }
 
 Image read_exr(const std::string& path, ImageMetadata* metadata, Image* variance) {

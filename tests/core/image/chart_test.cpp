@@ -29,6 +29,13 @@ fs::path test_directory() {
   return directory;
 }
 
+class RemoveTestDirectory : public ::testing::Environment {
+ public:
+  void TearDown() override { fs::remove_all(test_directory()); }
+};
+const ::testing::Environment* const kRemoveTestDirectory =
+    ::testing::AddGlobalTestEnvironment(new RemoveTestDirectory);
+
 ChartSpec convergence_chart() {
   ChartSpec spec;
   spec.title = "MRSE against samples #1";

@@ -31,6 +31,14 @@ fs::path test_directory() {
   return directory;
 }
 
+// Removes the directory when the program ends.
+class RemoveTestDirectory : public ::testing::Environment {
+ public:
+  void TearDown() override { fs::remove_all(test_directory()); }
+};
+const ::testing::Environment* const kRemoveTestDirectory =
+    ::testing::AddGlobalTestEnvironment(new RemoveTestDirectory);
+
 // Random floats over many magnitudes and both signs, plus special-but-finite values, so a lossy
 // path (half conversion, a float->double->float slip) would change some bits.
 Image random_image(int width, int height, uint32_t seed) {
@@ -206,6 +214,28 @@ TEST(ExrFile, ErrorsNameThePath) {
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find(unwritable), std::string::npos) << error.what();
   }
+}
+
+TEST(ExrFile, OverwritesAndLeavesNoTemporaryFiles) {
+  fs::path directory = test_directory() / "overwrite";
+  fs::create_directories(directory);
+  std::string path = (directory / "image.exr").string();
+  Image first = random_image(8, 8, 16), second = random_image(5, 3, 17);
+  write_exr(path, first, nullptr, {{"penumbra:pass", "1"}});
+  write_exr(path, second, nullptr, {{"penumbra:pass", "2"}});
+  ImageMetadata metadata;
+  expect_bit_identical(read_exr(path, &metadata), second);
+  EXPECT_EQ(metadata.at("penumbra:pass"), "2");
+  // The bytes on disk are exactly encode_exr's.
+  std::ifstream file(path, std::ios::binary);
+  std::string on_disk((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(on_disk, encode_exr(second, nullptr, {{"penumbra:pass", "2"}}));
+  size_t entries = 0;
+  for (const auto& entry : fs::directory_iterator(directory)) {
+    ++entries;
+    EXPECT_EQ(entry.path().filename(), "image.exr");
+  }
+  EXPECT_EQ(entries, 1u);
 }
 
 TEST(ExrFile, MismatchedVarianceIsRefused) {
