@@ -5,6 +5,7 @@
 
 #include "core/lights/light_geometry.h"
 #include "core/materials/bsdf.h"
+#include "core/polygon/psa_strategy.h"
 #include "core/strategies/area_strategy.h"
 #include "core/strategies/bsdf_strategy.h"
 #include "core/strategies/solid_angle_strategy.h"
@@ -14,7 +15,8 @@ namespace penumbra {
 namespace {
 
 // monostate: not prepared (never sampled or evaluated).
-using PreparedStrategy = std::variant<std::monostate, AreaStrategy, SolidAngleStrategy, BsdfStrategy>;
+using PreparedStrategy = std::variant<std::monostate, AreaStrategy, SolidAngleStrategy, BsdfStrategy,
+                                      ProjectedSolidAngleStrategy>;
 
 std::optional<LightPoint> sample_strategy(const PreparedStrategy& strategy, const Vec2& u) {
   return std::visit(
@@ -39,6 +41,7 @@ PreparedStrategy prepare(StrategyKind kind, const ShadingPoint& sp, const Light&
     case StrategyKind::Area: return AreaStrategy(sp, light);
     case StrategyKind::SolidAngle: return SolidAngleStrategy(sp, light);
     case StrategyKind::Bsdf: return BsdfStrategy(sp, light);
+    case StrategyKind::ProjectedSolidAngle: return ProjectedSolidAngleStrategy(sp, light);
     default: break;
   }
   // The constructor of DirectLighting refuses every other kind before we get here.
@@ -118,9 +121,14 @@ DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
       case StrategyKind::SolidAngle:
       case StrategyKind::Bsdf: break;
       case StrategyKind::ProjectedSolidAngle:
+        for (size_t l = 0; l < scene.lights.size(); ++l)
+          if (scene.lights[l].type == LightType::Disk)
+            refuse(method, "strategy \"psa\" samples polygons and quads; light " +
+                               std::to_string(l) + " is a disk (use sa or area)");
+        break;
       case StrategyKind::Ltc:
         refuse(method, "strategy \"" + std::string(strategy_name(term.strategy)) +
-                           "\" is not available yet (Peters 2021 polygon sampling, issue #4)");
+                           "\" is not available yet (Peters 2021 LTC sampling, issue #4)");
       case StrategyKind::LineArea:
       case StrategyKind::LineSolidAngle:
       case StrategyKind::LineBd16:

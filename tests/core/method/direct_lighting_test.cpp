@@ -135,7 +135,9 @@ INSTANTIATE_TEST_SUITE_P(
                       UnbiasedCase{"area+2*sa/balance", Pattern::Random},
                       UnbiasedCase{"area+bsdf+sa/power", Pattern::Random},
                       UnbiasedCase{"4*sa", Pattern::Stratified},
-                      UnbiasedCase{"4*area+4*bsdf", Pattern::Cmj}),
+                      UnbiasedCase{"4*area+4*bsdf", Pattern::Cmj},
+                      UnbiasedCase{"psa", Pattern::Random},
+                      UnbiasedCase{"bsdf+psa/power", Pattern::Random}),
     [](const auto& info) {
       std::string name = info.param.method;
       for (char& ch : name)
@@ -148,7 +150,7 @@ TEST(DirectLighting, MisWeightsSumToOneWhereAnyPdfIsNonzero) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
   for (const char* method : {"bsdf+sa", "bsdf+sa/power", "bsdf+sa/avg", "area+3*sa+bsdf/balance",
-                             "2*area+bsdf/power"}) {
+                             "2*area+bsdf/power", "psa+bsdf", "psa+sa+area/power"}) {
     for (const Light& light : test_lights()) {
       Scene scene = single_light_scene(light);
       DirectLighting direct(scene, parse_method(method));
@@ -218,7 +220,8 @@ TEST(DirectLighting, FiniteInDegenerateConfigurations) {
     Scene scene = single_light_scene(c.light);
     ShadingPoint sp = c.point;
     sp.material = &scene.materials[0];
-    for (const char* method : {"area", "sa", "bsdf", "bsdf+sa", "bsdf+sa/power", "area+sa/avg"}) {
+    for (const char* method :
+         {"area", "sa", "bsdf", "psa", "bsdf+sa", "bsdf+sa/power", "area+sa/avg", "psa+bsdf"}) {
       DirectLighting direct(scene, parse_method(method));
       for (uint32_t t = 0; t < 2000; ++t) {
         Rgb value = direct.estimate(sp, visibility, Pattern::Random, {1, 0, t, 0});
