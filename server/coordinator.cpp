@@ -1,0 +1,840 @@
+#include "server/coordinator.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <random>
+#include <tuple>
+
+#include "core/image/metrics.h"
+#include "core/method/method.h"
+#include "core/render/renderer.h"
+#include "core/sampling/pattern.h"
+#include "penumbra/version.h"
+
+namespace penumbra::farm {
+
+namespace {
+
+int64_t unix_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+bool is_terminal(int state) {
+  return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+FarmError invalid(const std::string& message) {
+  return FarmError(FarmErrorCode::InvalidArgument, message);
+}
+
+}  // namespace
+
+struct Coordinator::Job {
+  JobRecord record;
+  v1::StoredJob stored;
+  uint64_t tile_count = 0;
+  std::vector<TileRect> tiles;                  // empty once the job ended
+  std::shared_ptr<const Scene> scene;           // null once the job ended
+  uint32_t total_blocks = 0;                    // spp budget; seconds budget: the most it may open
+  std::vector<TileAccumulator> sealed;          // per tile, blocks [0, blocks_sealed)
+  std::map<uint64_t, TileAccumulator> pending;  // completed tasks of unsealed blocks
+  std::map<uint64_t, int> failures;
+  uint64_t tasks_completed_ever = 0;  // for the average task cost (seconds budgets)
+  double task_seconds_ever = 0;
+  std::vector<CurvePoint> curve;
+  std::optional<Image> reference;
+  bool has_mrse = false;
+  double mrse = 0;
+  v1::RegionErrors errors;
+
+  const v1::JobSpec& spec() const { return stored.spec(); }
+  bool seconds_budget() const { return spec().budget_case() == v1::JobSpec::kComputeSeconds; }
+};
+
+std::string Coordinator::job_name(uint64_t job_id) {
+  return "job-" + std::to_string(job_id);
+}
+
+Coordinator::Coordinator(CoordinatorOptions options, SceneParser parser)
+    : options_(std::move(options)),
+      parser_(std::move(parser)),
+      store_(options_.data_dir),
+      leases_(options_.lease_time, std::random_device{}()) {
+  if (options_.build_flavour.empty()) options_.build_flavour = kBuildFlavour;
+  for (const JobRecord& record : store_.jobs()) resume(record);
+  expiry_thread_ = std::thread([this] { expiry_loop(); });
+}
+
+Coordinator::~Coordinator() {
+  {
+    std::lock_guard lock(expiry_mutex_);
+    stopping_ = true;
+  }
+  expiry_wake_.notify_all();
+  expiry_thread_.join();
+}
+
+void Coordinator::expiry_loop() {
+  auto period = std::max(std::chrono::milliseconds(10), options_.lease_time / 4);
+  std::unique_lock lock(expiry_mutex_);
+  while (!expiry_wake_.wait_for(lock, period, [this] { return stopping_; })) {
+    lock.unlock();
+    expire_leases();
+    lock.lock();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Jobs
+
+void Coordinator::resume(const JobRecord& record) {
+  auto job = std::make_unique<Job>();
+  job->record = record;
+  if (!job->stored.ParseFromString(record.spec)) {
+    spdlog::error("{}: stored spec is unreadable; marking it failed", job_name(record.id));
+    job->record.state = v1::JOB_STATE_FAILED;
+    job->record.error = "stored job specification is unreadable";
+    store_.update_job(job->record);
+    jobs_[record.id] = std::move(job);
+    return;
+  }
+  Job& j = *job;
+  jobs_[record.id] = std::move(job);
+  const uint32_t tile_size = j.stored.tile_size();
+  j.tile_count = cut_tiles(int(j.stored.width()), int(j.stored.height()), int(tile_size)).size();
+  if (!j.record.final_errors.empty()) j.errors.ParseFromString(j.record.final_errors);
+  j.curve = store_.curve(record.id);
+  if (!j.curve.empty()) {
+    j.has_mrse = true;
+    j.mrse = j.curve.back().mrse;
+  }
+  if (is_terminal(record.state)) return;
+
+  try {
+    auto package = store_.scene(j.spec().scene_hash());
+    if (!package) throw FarmError(FarmErrorCode::NotFound, "scene is missing from the store");
+    v1::ScenePackage scene_package;
+    scene_package.ParseFromString(*package);
+    j.scene = std::make_shared<const Scene>(parser_(scene_package));
+    j.tiles = cut_tiles(int(j.stored.width()), int(j.stored.height()), int(tile_size));
+    j.sealed.reserve(j.tiles.size());
+    auto sealed = store_.tiles(record.id);
+    for (size_t t = 0; t < j.tiles.size(); ++t) {
+      auto it = sealed.find(uint32_t(t));
+      j.sealed.push_back(it == sealed.end() ? TileAccumulator(j.tiles[t])
+                                            : TileAccumulator::deserialize(it->second));
+    }
+    for (TaskResultRecord& result : store_.task_results(record.id)) {
+      j.pending.emplace(result.task_index, TileAccumulator::deserialize(result.tile));
+      j.record.blocks_opened = std::max<uint32_t>(j.record.blocks_opened,
+                                                  uint32_t(result.task_index / j.tile_count) + 1);
+    }
+  } catch (const std::exception& error) {
+    spdlog::error("{}: cannot resume: {}", job_name(record.id), error.what());
+    end_job(j, v1::JOB_STATE_FAILED, std::string("cannot resume after restart: ") + error.what());
+    return;
+  }
+  const uint32_t passes_per_task = j.stored.passes_per_task();
+  j.total_blocks = j.seconds_budget() ? options_.max_spp / passes_per_task
+                                      : (j.spec().spp() + passes_per_task - 1) / passes_per_task;
+  // An spp job opens every block at submission; a crash may have come before that was written.
+  if (!j.seconds_budget()) j.record.blocks_opened = j.total_blocks;
+  j.record.blocks_opened = std::max<uint32_t>(j.record.blocks_opened, 1);
+  j.tasks_completed_ever = uint64_t(j.record.blocks_sealed) * j.tile_count + j.pending.size();
+  j.task_seconds_ever = j.record.compute_seconds;
+  scheduler_.add_job(record.id, record.priority, record.id);
+  for (uint64_t task = uint64_t(j.record.blocks_sealed) * j.tile_count;
+       task < uint64_t(j.record.blocks_opened) * j.tile_count; ++task)
+    if (!j.pending.count(task)) scheduler_.enqueue({record.id, task});
+  load_reference(j);
+  spdlog::info("{}: resumed with {} of {} blocks sealed, {} tasks queued", job_name(record.id),
+               j.record.blocks_sealed, j.record.blocks_opened, scheduler_.queued(record.id));
+  seal_ready_blocks(j);
+  if (!is_terminal(j.record.state)) maybe_open_block(j);
+}
+
+v1::SubmitJobResponse Coordinator::submit(const v1::JobSpec& request) {
+  // Validation and scene parsing happen outside the lock: they can take a while.
+  v1::JobSpec spec = request;
+  if (spec.method().empty()) throw invalid("spec.method: empty; give a method such as \"sa\"");
+  try {
+    parse_method(spec.method());
+  } catch (const FormatError& error) {
+    throw invalid(error.what());
+  }
+  if (spec.sampler().empty()) spec.set_sampler("stratified");
+  if (!parse_pattern(spec.sampler()))
+    throw invalid("spec.sampler: unknown sampler \"" + spec.sampler() + "\"");
+  switch (spec.budget_case()) {
+    case v1::JobSpec::kSpp:
+      if (spec.spp() == 0) throw invalid("spec.spp: the budget must be at least 1 pass");
+      if (spec.spp() > options_.max_spp)
+        throw FarmError(FarmErrorCode::ResourceExhausted,
+                        "spec.spp: " + std::to_string(spec.spp()) + " passes exceed the limit of " +
+                            std::to_string(options_.max_spp));
+      break;
+    case v1::JobSpec::kComputeSeconds:
+      if (!(spec.compute_seconds() > 0) || !std::isfinite(spec.compute_seconds()))
+        throw invalid("spec.compute_seconds: the budget must be a positive number of seconds");
+      if (spec.compute_seconds() > options_.max_seconds_budget)
+        throw FarmError(FarmErrorCode::ResourceExhausted,
+                        "spec.compute_seconds: the budget exceeds the limit of " +
+                            std::to_string(options_.max_seconds_budget) + " s");
+      break;
+    default:
+      throw invalid("spec.budget: give spp or compute_seconds");
+  }
+  uint32_t tile_size = spec.tile_size() ? spec.tile_size() : options_.default_tile_size;
+  if (tile_size < 4 || tile_size > 1024)
+    throw invalid("spec.tile_size: " + std::to_string(tile_size) + " is outside [4, 1024]");
+  uint32_t passes_per_task =
+      spec.passes_per_task() ? spec.passes_per_task() : options_.default_passes_per_task;
+  if (passes_per_task > 4096)
+    throw invalid("spec.passes_per_task: " + std::to_string(passes_per_task) +
+                  " is outside [1, 4096]");
+
+  // The scene: parse the package (never a path) or find the uploaded one by hash.
+  v1::ScenePackage package;
+  if (spec.has_scene()) {
+    package = spec.scene();
+    size_t bytes = package.scene_json().size();
+    for (const auto& [path, data] : package.files()) bytes += path.size() + data.size();
+    if (bytes > options_.max_scene_bytes)
+      throw FarmError(FarmErrorCode::ResourceExhausted,
+                      "spec.scene: " + std::to_string(bytes) + " bytes exceed the limit of " +
+                          std::to_string(options_.max_scene_bytes));
+  } else if (!spec.scene_hash().empty()) {
+    auto stored = store_.scene(spec.scene_hash());
+    if (!stored)
+      throw FarmError(FarmErrorCode::NotFound,
+                      "spec.scene_hash: no scene " + spec.scene_hash() + " on this coordinator");
+    package.ParseFromString(*stored);
+  } else {
+    throw invalid("spec.scene: give a scene package or the hash of an uploaded scene");
+  }
+  std::shared_ptr<const Scene> scene;
+  try {
+    scene = std::make_shared<const Scene>(parser_(package));
+  } catch (const FormatError& error) {
+    throw invalid(std::string("scene: ") + error.what());
+  }
+  if (!spec.scene_hash().empty() && spec.scene_hash() != scene->content_hash)
+    throw invalid("spec.scene_hash: " + spec.scene_hash() + " does not match the scene's hash " +
+                  scene->content_hash);
+
+  std::optional<Image> reference;
+  if (spec.reference_case() == v1::JobSpec::kReferenceExr) {
+    try {
+      reference = decode_exr(spec.reference_exr());
+    } catch (const std::exception& error) {
+      throw invalid(std::string("spec.reference_exr: not a readable EXR: ") + error.what());
+    }
+    if (reference->width != scene->camera.width || reference->height != scene->camera.height)
+      throw invalid("spec.reference_exr: " + std::to_string(reference->width) + "x" +
+                    std::to_string(reference->height) + " does not match the scene's " +
+                    std::to_string(scene->camera.width) + "x" +
+                    std::to_string(scene->camera.height));
+  }
+
+  auto tiles = cut_tiles(scene->camera.width, scene->camera.height, int(tile_size));
+  if (spec.has_scene()) store_.put_scene(scene->content_hash, package.SerializeAsString());
+  spec.clear_scene();
+  spec.set_scene_hash(scene->content_hash);
+
+  Notifications notifications;
+  v1::SubmitJobResponse response;
+  {
+    std::lock_guard lock(mutex_);
+    if (spec.reference_case() == v1::JobSpec::kReferenceJob) {
+      uint64_t reference_id = parse_job_id(spec.reference_job());
+      auto it = jobs_.find(reference_id);
+      if (it == jobs_.end())
+        throw FarmError(FarmErrorCode::NotFound,
+                        "spec.reference_job: no job " + spec.reference_job());
+      if (it->second->stored.width() != uint32_t(scene->camera.width) ||
+          it->second->stored.height() != uint32_t(scene->camera.height))
+        throw invalid("spec.reference_job: " + spec.reference_job() +
+                      " has another resolution than this scene");
+      spec.set_reference_job(job_name(reference_id));
+    }
+    auto job = std::make_unique<Job>();
+    job->stored.mutable_spec()->CopyFrom(spec);
+    job->stored.set_scene_name(scene->name);
+    job->stored.set_width(uint32_t(scene->camera.width));
+    job->stored.set_height(uint32_t(scene->camera.height));
+    job->stored.set_tile_size(tile_size);
+    job->stored.set_passes_per_task(passes_per_task);
+    job->tiles = std::move(tiles);
+    job->tile_count = job->tiles.size();
+    job->total_blocks = job->seconds_budget()
+                            ? options_.max_spp / passes_per_task
+                            : (spec.spp() + passes_per_task - 1) / passes_per_task;
+    uint64_t new_tasks =
+        job->tile_count * (job->seconds_budget() ? 1 : uint64_t(job->total_blocks));
+    if (scheduler_.queued_total() + new_tasks > options_.max_queued_tasks)
+      throw FarmError(FarmErrorCode::ResourceExhausted,
+                      "the coordinator's queue is full: " + std::to_string(new_tasks) +
+                          " more tasks would exceed " + std::to_string(options_.max_queued_tasks));
+    job->scene = scene;
+    job->reference = std::move(reference);
+    job->record.spec = job->stored.SerializeAsString();
+    job->record.priority = spec.priority();
+    job->record.state = v1::JOB_STATE_QUEUED;
+    job->record.submitted_unix_ms = unix_ms();
+    job->record.id = store_.add_job(job->record);
+    uint64_t id = job->record.id;
+    Job& j = *job;
+    jobs_[id] = std::move(job);
+    scheduler_.add_job(id, spec.priority(), id);
+    if (j.seconds_budget()) {
+      open_block(j);
+    } else {
+      while (j.record.blocks_opened < j.total_blocks) open_block(j);
+    }
+    store_.update_job(j.record);
+    j.sealed.reserve(j.tiles.size());
+    for (const TileRect& tile : j.tiles) j.sealed.emplace_back(tile);
+    load_reference(j);
+    spdlog::info("{}: submitted: scene {} ({}x{}), method {}, sampler {}, {} tiles, priority {}",
+                 job_name(id), scene->name, scene->camera.width, scene->camera.height,
+                 spec.method(), spec.sampler(), j.tile_count, spec.priority());
+    response.set_job_id(job_name(id));
+    response.set_scene_hash(scene->content_hash);
+    collect_notifications(id, notifications);
+  }
+  run(notifications);
+  return response;
+}
+
+void Coordinator::open_block(Job& job) {
+  uint64_t first = uint64_t(job.record.blocks_opened) * job.tile_count;
+  for (uint64_t tile = 0; tile < job.tile_count; ++tile)
+    scheduler_.enqueue({job.record.id, first + tile});
+  ++job.record.blocks_opened;
+}
+
+// Seconds budgets: opens the next pass block when the job has nothing queued, is at most one
+// block ahead of the sealed ones, and the compute spent plus the expected cost of the tasks in
+// flight stays under the budget.
+void Coordinator::maybe_open_block(Job& job) {
+  if (!job.seconds_budget() || is_terminal(job.record.state)) return;
+  if (scheduler_.queued(job.record.id) != 0) return;
+  if (job.record.blocks_opened >= job.total_blocks) return;
+  if (job.record.blocks_opened > job.record.blocks_sealed + 1) return;
+  if (job.tasks_completed_ever == 0) return;  // no cost estimate yet
+  uint64_t done = uint64_t(job.record.blocks_sealed) * job.tile_count + job.pending.size();
+  uint64_t in_flight = uint64_t(job.record.blocks_opened) * job.tile_count - done;
+  double average = job.task_seconds_ever / double(job.tasks_completed_ever);
+  if (job.record.compute_seconds + double(in_flight) * average < job.spec().compute_seconds())
+    open_block(job);
+}
+
+void Coordinator::load_reference(Job& job) {
+  if (job.reference || job.spec().reference_case() == v1::JobSpec::REFERENCE_NOT_SET) return;
+  try {
+    if (job.spec().reference_case() == v1::JobSpec::kReferenceExr) {
+      job.reference = decode_exr(job.spec().reference_exr());
+      return;
+    }
+    uint64_t reference_id = parse_job_id(job.spec().reference_job());
+    auto it = jobs_.find(reference_id);
+    if (it == jobs_.end() || it->second->record.state != v1::JOB_STATE_DONE) return;
+    if (auto exr = store_.result(reference_id)) job.reference = decode_exr(*exr);
+  } catch (const std::exception& error) {
+    spdlog::warn("{}: cannot load its reference: {}", job_name(job.record.id), error.what());
+  }
+}
+
+void Coordinator::seal_ready_blocks(Job& job) {
+  while (!is_terminal(job.record.state) && job.record.blocks_sealed < job.record.blocks_opened) {
+    uint64_t first = uint64_t(job.record.blocks_sealed) * job.tile_count;
+    uint64_t end = first + job.tile_count;
+    auto begin_it = job.pending.lower_bound(first);
+    auto end_it = job.pending.lower_bound(end);
+    if (uint64_t(std::distance(begin_it, end_it)) != job.tile_count) break;
+    std::map<uint32_t, std::string> tiles;
+    for (auto it = begin_it; it != end_it; ++it) {
+      uint32_t tile = uint32_t(it->first - first);
+      job.sealed[tile].merge(it->second);
+      tiles[tile] = job.sealed[tile].serialize();
+    }
+    job.pending.erase(begin_it, end_it);
+    ++job.record.blocks_sealed;
+    uint32_t passes = task_passes(job, end - 1).second;
+    std::optional<CurvePoint> point;
+    load_reference(job);
+    if (job.reference) {
+      Film film = assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+      try {
+        CurvePoint p;
+        p.passes = passes;
+        p.compute_seconds = job.record.compute_seconds;
+        p.wall_seconds = double(unix_ms() - job.record.started_unix_ms) / 1000.0;
+        p.mrse = mrse(film.color, *job.reference);
+        point = p;
+        job.curve.push_back(p);
+        job.has_mrse = true;
+        job.mrse = p.mrse;
+      } catch (const std::exception& error) {
+        spdlog::warn("{}: no MRSE: {}", job_name(job.record.id), error.what());
+      }
+    }
+    store_.seal_block(job.record, tiles, first, end, point);
+    spdlog::debug("{}: {} passes sealed", job_name(job.record.id), passes);
+  }
+  maybe_open_block(job);
+  if (!is_terminal(job.record.state) && job.record.blocks_sealed == job.record.blocks_opened &&
+      scheduler_.queued(job.record.id) == 0 &&
+      (job.seconds_budget() || job.record.blocks_sealed == job.total_blocks))
+    finish(job);
+}
+
+void Coordinator::finish(Job& job) {
+  uint32_t spp =
+      job.record.blocks_sealed == 0
+          ? 0
+          : task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second;
+  Film film = assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+  RenderOptions render_options;
+  render_options.method = job.spec().method();
+  render_options.sampler = parse_pattern(job.spec().sampler()).value_or(Pattern::Stratified);
+  render_options.seed = job.spec().seed();
+  ImageMetadata metadata =
+      render_metadata(*job.scene, render_options, spp, job.record.compute_seconds);
+  metadata["penumbra:job"] = job_name(job.record.id);
+  std::string exr;
+  try {
+    exr = encode_exr(film.color, &film.variance, metadata);
+  } catch (const std::exception& error) {
+    end_job(job, v1::JOB_STATE_FAILED, std::string("cannot encode the EXR: ") + error.what());
+    return;
+  }
+  load_reference(job);
+  if (job.reference) {
+    try {
+      for (const auto& [region, summary] :
+           error_summary(film.color, *job.reference, job.scene->regions)) {
+        v1::RegionError* error = job.errors.add_errors();
+        error->set_region(region);
+        error->set_mrse(summary.mrse);
+        error->set_mse(summary.mse);
+        error->set_rmse(summary.rmse);
+      }
+      job.record.final_errors = job.errors.SerializeAsString();
+    } catch (const std::exception& error) {
+      spdlog::warn("{}: no final errors: {}", job_name(job.record.id), error.what());
+    }
+  }
+  if (film.nonfinite_samples)
+    spdlog::error("{}: {} samples were not finite (counted as zero)", job_name(job.record.id),
+                  film.nonfinite_samples);
+  job.record.state = v1::JOB_STATE_DONE;
+  job.record.finished_unix_ms = unix_ms();
+  store_.finish_job(job.record, exr);
+  spdlog::info("{}: done: {} spp, {:.2f} compute seconds, {:.2f} wall seconds",
+               job_name(job.record.id), spp, job.record.compute_seconds,
+               double(job.record.finished_unix_ms - job.record.started_unix_ms) / 1000.0);
+  end_job(job, v1::JOB_STATE_DONE, "");
+}
+
+// Releases what a job that ended no longer needs, in memory and in the store.
+void Coordinator::end_job(Job& job, v1::JobState state, const std::string& error) {
+  job.record.state = state;
+  if (!error.empty()) job.record.error = error;
+  if (!job.record.finished_unix_ms) job.record.finished_unix_ms = unix_ms();
+  scheduler_.remove_job(job.record.id);
+  leases_.release_job(job.record.id);
+  job.sealed.clear();
+  job.sealed.shrink_to_fit();
+  job.pending.clear();
+  job.tiles.clear();
+  job.failures.clear();
+  store_.drop_work(job.record);
+}
+
+uint64_t Coordinator::parse_job_id(const std::string& job_id) const {
+  std::string digits = job_id.rfind("job-", 0) == 0 ? job_id.substr(4) : job_id;
+  if (digits.empty() || digits.size() > 18 ||
+      !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    throw FarmError(FarmErrorCode::NotFound, "no job \"" + job_id + "\" (job ids look like job-7)");
+  return std::stoull(digits);
+}
+
+Coordinator::Job& Coordinator::job_locked(const std::string& job_id) {
+  auto it = jobs_.find(parse_job_id(job_id));
+  if (it == jobs_.end()) throw FarmError(FarmErrorCode::NotFound, "no job " + job_id);
+  return *it->second;
+}
+
+TileRect Coordinator::task_tile(const Job& job, uint64_t task_index) const {
+  return job.tiles[task_index % job.tile_count];
+}
+
+std::pair<uint32_t, uint32_t> Coordinator::task_passes(const Job& job, uint64_t task_index) const {
+  uint32_t block = uint32_t(task_index / job.tile_count);
+  uint32_t begin = block * job.stored.passes_per_task();
+  uint32_t end = begin + job.stored.passes_per_task();
+  if (!job.seconds_budget()) end = std::min(end, job.spec().spp());
+  return {begin, end};
+}
+
+v1::JobStatus Coordinator::status_locked(const Job& job, bool with_curve) const {
+  v1::JobStatus status;
+  const JobRecord& record = job.record;
+  status.set_job_id(job_name(record.id));
+  status.set_state(v1::JobState(record.state));
+  status.set_error(record.error);
+  status.set_name(job.spec().name());
+  status.set_priority(record.priority);
+  status.set_scene_name(job.stored.scene_name());
+  status.set_scene_hash(job.spec().scene_hash());
+  status.set_method(job.spec().method());
+  status.set_sampler(job.spec().sampler());
+  status.set_seed(job.spec().seed());
+  status.set_width(job.stored.width());
+  status.set_height(job.stored.height());
+  status.set_spp_budget(job.seconds_budget() ? 0 : job.spec().spp());
+  status.set_seconds_budget(job.seconds_budget() ? job.spec().compute_seconds() : 0);
+  uint32_t ppt = job.stored.passes_per_task();
+  auto passes_of_blocks = [&](uint32_t blocks) {
+    uint32_t passes = blocks * ppt;
+    return job.seconds_budget() ? passes : std::min(passes, job.spec().spp());
+  };
+  status.set_passes_complete(passes_of_blocks(record.blocks_sealed));
+  status.set_passes_planned(passes_of_blocks(record.blocks_opened));
+  status.set_tiles_total(uint32_t(job.tile_count));
+  uint64_t open_blocks = record.blocks_opened - record.blocks_sealed;
+  uint32_t tiles_complete = 0;
+  if (open_blocks == 0) {
+    tiles_complete = uint32_t(job.tile_count);
+  } else if (!is_terminal(record.state)) {
+    std::vector<uint32_t> done_per_tile(job.tile_count, 0);
+    for (const auto& [task, tile] : job.pending) ++done_per_tile[task % job.tile_count];
+    for (uint32_t done : done_per_tile) tiles_complete += done == open_blocks;
+  }
+  status.set_tiles_complete(tiles_complete);
+  status.set_tasks_total(uint64_t(record.blocks_opened) * job.tile_count);
+  status.set_tasks_complete(uint64_t(record.blocks_sealed) * job.tile_count + job.pending.size());
+  status.set_compute_seconds(record.compute_seconds);
+  if (record.started_unix_ms) {
+    int64_t end =
+        is_terminal(record.state) && record.finished_unix_ms ? record.finished_unix_ms : unix_ms();
+    status.set_wall_seconds(double(end - record.started_unix_ms) / 1000.0);
+  }
+  status.set_has_mrse(job.has_mrse);
+  status.set_mrse(job.mrse);
+  if (with_curve) {
+    for (const CurvePoint& point : job.curve) {
+      v1::ErrorSample* sample = status.add_curve();
+      sample->set_passes(point.passes);
+      sample->set_compute_seconds(point.compute_seconds);
+      sample->set_wall_seconds(point.wall_seconds);
+      sample->set_mrse(point.mrse);
+    }
+  }
+  *status.mutable_errors() = job.errors.errors();
+  status.set_submitted_unix_ms(record.submitted_unix_ms);
+  status.set_has_reference(job.spec().reference_case() != v1::JobSpec::REFERENCE_NOT_SET);
+  return status;
+}
+
+v1::JobStatus Coordinator::status(const std::string& job_id, bool with_curve) {
+  std::lock_guard lock(mutex_);
+  return status_locked(job_locked(job_id), with_curve);
+}
+
+std::vector<v1::JobStatus> Coordinator::list() {
+  std::lock_guard lock(mutex_);
+  std::vector<v1::JobStatus> result;
+  for (const auto& [id, job] : jobs_) result.push_back(status_locked(*job, false));
+  return result;
+}
+
+v1::JobState Coordinator::cancel(const std::string& job_id) {
+  Notifications notifications;
+  v1::JobState state;
+  {
+    std::lock_guard lock(mutex_);
+    Job& job = job_locked(job_id);
+    if (!is_terminal(job.record.state)) {
+      end_job(job, v1::JOB_STATE_CANCELLED, "cancelled");
+      spdlog::info("{}: cancelled", job_name(job.record.id));
+    }
+    state = v1::JobState(job.record.state);
+    collect_notifications(job.record.id, notifications);
+  }
+  run(notifications);
+  return state;
+}
+
+std::string Coordinator::result_exr(const std::string& job_id) {
+  uint64_t id;
+  {
+    std::lock_guard lock(mutex_);
+    Job& job = job_locked(job_id);
+    if (job.record.state != v1::JOB_STATE_DONE)
+      throw FarmError(FarmErrorCode::FailedPrecondition,
+                      job_id + " has no result: it is " +
+                          v1::JobState_Name(v1::JobState(job.record.state)) +
+                          (job.record.error.empty() ? "" : " (" + job.record.error + ")"));
+    id = job.record.id;
+  }
+  auto exr = store_.result(id);
+  if (!exr) throw FarmError(FarmErrorCode::Internal, job_id + ": the stored result is missing");
+  return *exr;
+}
+
+Film Coordinator::result_film(const std::string& job_id) {
+  Film film;
+  film.color = decode_exr(result_exr(job_id), nullptr, &film.variance);
+  return film;
+}
+
+uint64_t Coordinator::subscribe(const std::string& job_id, std::function<void()> on_change) {
+  std::lock_guard lock(mutex_);
+  uint64_t id = job_locked(job_id).record.id;
+  uint64_t subscription = next_subscription_++;
+  subscriptions_[subscription] = {id, std::move(on_change)};
+  return subscription;
+}
+
+void Coordinator::unsubscribe(uint64_t subscription) {
+  std::lock_guard lock(mutex_);
+  subscriptions_.erase(subscription);
+}
+
+void Coordinator::collect_notifications(uint64_t job_id, Notifications& out) const {
+  for (const auto& [id, subscription] : subscriptions_)
+    if (subscription.first == job_id) out.push_back(subscription.second);
+}
+
+void Coordinator::run(const Notifications& notifications) {
+  for (const auto& notify : notifications) notify();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Workers
+
+v1::RegisterResponse Coordinator::register_worker(const v1::RegisterRequest& request) {
+  if (request.protocol_version() != v1::PROTOCOL_VERSION_CURRENT)
+    throw FarmError(
+        FarmErrorCode::FailedPrecondition,
+        "worker speaks protocol version " + std::to_string(int(request.protocol_version())) +
+            "; this coordinator speaks " + std::to_string(int(v1::PROTOCOL_VERSION_CURRENT)));
+  if (request.build_flavour() != options_.build_flavour)
+    throw FarmError(FarmErrorCode::FailedPrecondition,
+                    "worker build \"" + request.build_flavour() +
+                        "\" would render different bits than this coordinator's build \"" +
+                        options_.build_flavour +
+                        "\"; rebuild the worker from the same source "
+                        "with the same compiler and flags");
+  if (request.threads() == 0) throw invalid("threads: a worker needs at least one thread");
+  std::lock_guard lock(mutex_);
+  std::string id = "w" + std::to_string(next_worker_++) + "-" +
+                   (request.name().empty() ? std::string("worker") : request.name());
+  Worker& worker = workers_[id];
+  worker.name = request.name();
+  worker.threads = request.threads();
+  worker.version = request.version();
+  worker.build_flavour = request.build_flavour();
+  worker.last_contact = std::chrono::steady_clock::now();
+  spdlog::info("worker {} registered: {} threads, version {}", id, worker.threads, worker.version);
+  v1::RegisterResponse response;
+  response.set_worker_id(id);
+  double lease_seconds = std::chrono::duration<double>(options_.lease_time).count();
+  response.set_lease_seconds(lease_seconds);
+  response.set_heartbeat_seconds(lease_seconds / 3);
+  return response;
+}
+
+Coordinator::Worker& Coordinator::worker_locked(const std::string& worker_id) {
+  auto it = workers_.find(worker_id);
+  if (it == workers_.end())
+    throw FarmError(FarmErrorCode::NotFound,
+                    "no worker " + worker_id + " (register again: the coordinator restarted?)");
+  it->second.last_contact = std::chrono::steady_clock::now();
+  return it->second;
+}
+
+v1::HeartbeatResponse Coordinator::heartbeat(const v1::HeartbeatRequest& request) {
+  std::lock_guard lock(mutex_);
+  worker_locked(request.worker_id());
+  auto now = std::chrono::steady_clock::now();
+  v1::HeartbeatResponse response;
+  for (const std::string& token : request.attempt_tokens())
+    if (!leases_.extend(token, request.worker_id(), now)) response.add_revoked_tokens(token);
+  return response;
+}
+
+v1::LeaseTasksResponse Coordinator::lease_tasks(const v1::LeaseTasksRequest& request) {
+  Notifications notifications;
+  v1::LeaseTasksResponse response;
+  {
+    std::lock_guard lock(mutex_);
+    worker_locked(request.worker_id());
+    auto now = std::chrono::steady_clock::now();
+    uint32_t wanted = std::min(request.max_tasks(), options_.max_tasks_per_lease);
+    while (uint32_t(response.tasks_size()) < wanted) {
+      auto next = scheduler_.next();
+      if (!next) break;
+      Job& job = *jobs_.at(next->job_id);
+      if (job.record.state == v1::JOB_STATE_QUEUED) {
+        job.record.state = v1::JOB_STATE_RUNNING;
+        job.record.started_unix_ms = unix_ms();
+        collect_notifications(job.record.id, notifications);
+      }
+      v1::Task* task = response.add_tasks();
+      task->set_job_id(job_name(job.record.id));
+      task->set_task_index(next->task_index);
+      task->set_attempt_token(leases_.grant(*next, request.worker_id(), now));
+      task->set_scene_hash(job.spec().scene_hash());
+      task->set_method(job.spec().method());
+      task->set_sampler(job.spec().sampler());
+      task->set_seed(job.spec().seed());
+      TileRect tile = task_tile(job, next->task_index);
+      task->mutable_tile()->set_x0(tile.x0);
+      task->mutable_tile()->set_y0(tile.y0);
+      task->mutable_tile()->set_x1(tile.x1);
+      task->mutable_tile()->set_y1(tile.y1);
+      auto [pass_begin, pass_end] = task_passes(job, next->task_index);
+      task->set_pass_begin(pass_begin);
+      task->set_pass_end(pass_end);
+      maybe_open_block(job);
+    }
+  }
+  run(notifications);
+  return response;
+}
+
+v1::ScenePackage Coordinator::scene(const std::string& scene_hash) {
+  auto stored = store_.scene(scene_hash);
+  if (!stored) throw FarmError(FarmErrorCode::NotFound, "no scene " + scene_hash);
+  v1::ScenePackage package;
+  if (!package.ParseFromString(*stored))
+    throw FarmError(FarmErrorCode::Internal, "stored scene " + scene_hash + " is unreadable");
+  return package;
+}
+
+bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
+  // Check the tile's shape before taking the lock; it is most of the work.
+  TileAccumulator tile;
+  try {
+    tile = TileAccumulator::deserialize(request.tile());
+  } catch (const std::invalid_argument& error) {
+    throw invalid(std::string("tile: ") + error.what());
+  }
+  if (!std::isfinite(request.compute_seconds()) || request.compute_seconds() < 0)
+    throw invalid("compute_seconds: must be finite and not negative");
+  Notifications notifications;
+  {
+    std::lock_guard lock(mutex_);
+    const Lease* lease = leases_.find(request.attempt_token());
+    uint64_t job_id = 0;
+    try {
+      job_id = parse_job_id(request.job_id());
+    } catch (const FarmError&) {
+      return false;
+    }
+    if (!lease || lease->task.job_id != job_id || lease->task.task_index != request.task_index()) {
+      spdlog::debug("{} task {}: late or duplicate result from {} dropped", request.job_id(),
+                    request.task_index(), request.worker_id());
+      return false;
+    }
+    Job& job = *jobs_.at(job_id);
+    TileRect rect = task_tile(job, request.task_index());
+    auto [pass_begin, pass_end] = task_passes(job, request.task_index());
+    if (!(tile.rect() == rect))
+      throw invalid("tile: the result's rectangle does not match task " +
+                    std::to_string(request.task_index()));
+    for (int64_t i = 0; i < rect.pixel_count(); ++i)
+      if (tile.count(i) != pass_end - pass_begin)
+        throw invalid("tile: pixel " + std::to_string(i) + " has " + std::to_string(tile.count(i)) +
+                      " samples, the task asked for " + std::to_string(pass_end - pass_begin));
+    leases_.release(request.attempt_token());
+    auto worker = workers_.find(request.worker_id());
+    if (worker != workers_.end()) {
+      ++worker->second.tasks_completed;
+      worker->second.compute_seconds += request.compute_seconds();
+      worker->second.last_contact = std::chrono::steady_clock::now();
+    }
+    job.record.compute_seconds += request.compute_seconds();
+    ++job.tasks_completed_ever;
+    job.task_seconds_ever += request.compute_seconds();
+    if (!job.record.started_unix_ms) job.record.started_unix_ms = unix_ms();
+    store_.add_task_result(job.record,
+                           {request.task_index(), request.tile(), request.compute_seconds()});
+    job.pending.emplace(request.task_index(), std::move(tile));
+    seal_ready_blocks(job);
+    collect_notifications(job_id, notifications);
+  }
+  run(notifications);
+  return true;
+}
+
+void Coordinator::fail_task(const v1::FailTaskRequest& request) {
+  Notifications notifications;
+  {
+    std::lock_guard lock(mutex_);
+    auto lease = leases_.release(request.attempt_token());
+    if (!lease) return;  // stale: the task was already handed to someone else
+    Job& job = *jobs_.at(lease->task.job_id);
+    int failures = ++job.failures[lease->task.task_index];
+    spdlog::warn("{} task {}: failed on {} ({} of {}): {}", job_name(job.record.id),
+                 lease->task.task_index, request.worker_id(), failures, options_.max_task_failures,
+                 request.error());
+    if (failures >= options_.max_task_failures) {
+      end_job(job, v1::JOB_STATE_FAILED,
+              "task " + std::to_string(lease->task.task_index) + " failed " +
+                  std::to_string(failures) + " times; last error from worker " +
+                  request.worker_id() + ": " + request.error());
+    } else {
+      scheduler_.requeue(lease->task);
+    }
+    collect_notifications(job.record.id, notifications);
+  }
+  run(notifications);
+}
+
+void Coordinator::expire_leases() {
+  std::lock_guard lock(mutex_);
+  auto expired = leases_.expire(std::chrono::steady_clock::now());
+  std::sort(expired.begin(), expired.end(), [](const Lease& a, const Lease& b) {
+    return std::tuple(a.task.job_id, a.task.task_index) >
+           std::tuple(b.task.job_id, b.task.task_index);
+  });
+  for (const Lease& lease : expired) {
+    spdlog::warn("{} task {}: lease of worker {} expired; task queued again",
+                 job_name(lease.task.job_id), lease.task.task_index, lease.worker_id);
+    scheduler_.requeue(lease.task);
+  }
+}
+
+std::vector<v1::WorkerInfo> Coordinator::workers() {
+  std::lock_guard lock(mutex_);
+  auto now = std::chrono::steady_clock::now();
+  std::vector<v1::WorkerInfo> result;
+  for (const auto& [id, worker] : workers_) {
+    v1::WorkerInfo info;
+    info.set_worker_id(id);
+    info.set_name(worker.name);
+    info.set_threads(worker.threads);
+    info.set_version(worker.version);
+    info.set_build_flavour(worker.build_flavour);
+    double since = std::chrono::duration<double>(now - worker.last_contact).count();
+    info.set_seconds_since_heartbeat(since);
+    info.set_alive(since <= std::chrono::duration<double>(options_.lease_time).count());
+    info.set_tasks_leased(uint32_t(leases_.count_for_worker(id)));
+    info.set_tasks_completed(worker.tasks_completed);
+    info.set_compute_seconds(worker.compute_seconds);
+    result.push_back(info);
+  }
+  return result;
+}
+
+}  // namespace penumbra::farm

@@ -1,0 +1,72 @@
+// penumbra-coordinator: serves the farm's jobs and workers APIs.
+//   penumbra-coordinator --listen 0.0.0.0:7420 --data-dir /var/lib/penumbra
+#include <pthread.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+
+#include "proto/support/scene_packing.h"
+#include "server/coordinator_server.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"penumbra-coordinator: the Penumbra render farm's coordinator"};
+  std::string listen = "0.0.0.0:7420";
+  std::string data_dir = "penumbra-data";
+  std::string port_file;
+  std::string log_level = "info";
+  double lease_seconds = 30;
+  penumbra::farm::CoordinatorOptions options;
+  size_t max_scene_mib = 256;
+  app.add_option("--listen", listen, "host:port to serve on (port 0: any free port)");
+  app.add_option("--data-dir", data_dir, "folder of the SQLite state (created when missing)");
+  app.add_option("--port-file", port_file, "write the port it listens on to this file");
+  app.add_option("--lease-seconds", lease_seconds, "a lease not extended this long expires")
+      ->check(CLI::Range(0.05, 3600.0));
+  app.add_option("--tile-size", options.default_tile_size, "default tile side in pixels");
+  app.add_option("--passes-per-task", options.default_passes_per_task,
+                 "default passes in one task");
+  app.add_option("--max-scene-mib", max_scene_mib, "largest scene package accepted");
+  app.add_option("--max-queued-tasks", options.max_queued_tasks, "queue limit over all jobs");
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error");
+  CLI11_PARSE(app, argc, argv);
+
+  spdlog::set_level(spdlog::level::from_str(log_level));
+  options.data_dir = data_dir;
+  options.lease_time = std::chrono::milliseconds(int64_t(lease_seconds * 1000));
+  options.max_scene_bytes = max_scene_mib << 20;
+
+  // SIGINT and SIGTERM are taken by a thread that shuts the server down.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  try {
+    penumbra::farm::Coordinator coordinator(options, penumbra::farm::parse_wire_package);
+    penumbra::farm::CoordinatorServer server(coordinator, listen,
+                                             options.max_scene_bytes + (size_t(16) << 20));
+    spdlog::info("penumbra-coordinator listening on port {} (data in {})", server.port(), data_dir);
+    if (!port_file.empty()) {
+      std::string temporary = port_file + ".tmp";
+      std::ofstream(temporary) << server.port() << "\n";
+      std::rename(temporary.c_str(), port_file.c_str());
+    }
+    std::thread signal_thread([&] {
+      int signal = 0;
+      sigwait(&signals, &signal);
+      spdlog::info("signal {}: shutting down", signal);
+      server.shutdown();
+    });
+    server.wait();
+    signal_thread.join();
+  } catch (const std::exception& error) {
+    spdlog::critical("{}", error.what());
+    return 1;
+  }
+  return 0;
+}

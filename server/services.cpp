@@ -1,0 +1,241 @@
+#include "server/services.h"
+
+#include <algorithm>
+#include <memory>
+#include <mutex>
+
+#include "server/grpc_status.h"
+
+namespace penumbra::farm {
+
+namespace {
+
+template <typename Body>
+grpc::ServerUnaryReactor* unary(grpc::CallbackServerContext* context, Body&& body) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(handle(std::forward<Body>(body)));
+  return reactor;
+}
+
+bool is_terminal(v1::JobState state) {
+  return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+// WatchJob: writes the job's status whenever the coordinator says it changed (coalescing
+// changes that arrive during a write), and finishes after writing a final state.
+class WatchReactor final : public grpc::ServerWriteReactor<v1::JobStatus> {
+ public:
+  WatchReactor(Coordinator& coordinator, const std::string& job_id)
+      : coordinator_(coordinator), job_id_(job_id), link_(std::make_shared<Link>()) {
+    link_->reactor = this;
+    grpc::Status status = handle([&] {
+      std::weak_ptr<Link> link = link_;
+      subscription_ = coordinator_.subscribe(job_id_, [link] {
+        if (auto shared = link.lock()) {
+          std::lock_guard lock(shared->mutex);
+          if (shared->reactor) shared->reactor->on_change_locked();
+        }
+      });
+      subscribed_ = true;
+    });
+    std::lock_guard lock(link_->mutex);
+    if (!status.ok()) {
+      finish_locked(status);
+      return;
+    }
+    on_change_locked();
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::lock_guard lock(link_->mutex);
+    writing_ = false;
+    if (!ok || cancelled_) {
+      finish_locked(grpc::Status(grpc::StatusCode::CANCELLED, "watch cancelled"));
+    } else if (wrote_final_) {
+      finish_locked(grpc::Status::OK);
+    } else if (dirty_) {
+      write_locked();
+    }
+  }
+
+  void OnCancel() override {
+    std::lock_guard lock(link_->mutex);
+    cancelled_ = true;
+    if (!writing_) finish_locked(grpc::Status(grpc::StatusCode::CANCELLED, "watch cancelled"));
+  }
+
+  void OnDone() override {
+    {
+      std::lock_guard lock(link_->mutex);
+      link_->reactor = nullptr;
+    }
+    if (subscribed_) coordinator_.unsubscribe(subscription_);
+    delete this;
+  }
+
+ private:
+  struct Link {
+    std::mutex mutex;
+    WatchReactor* reactor = nullptr;
+  };
+
+  void on_change_locked() {
+    if (finished_ || wrote_final_) return;
+    if (writing_) {
+      dirty_ = true;
+      return;
+    }
+    write_locked();
+  }
+
+  void write_locked() {
+    dirty_ = false;
+    grpc::Status status = handle([&] { event_ = coordinator_.status(job_id_, false); });
+    if (!status.ok()) {
+      finish_locked(status);
+      return;
+    }
+    wrote_final_ = is_terminal(event_.state());
+    writing_ = true;
+    StartWrite(&event_);
+  }
+
+  void finish_locked(const grpc::Status& status) {
+    if (finished_) return;
+    finished_ = true;
+    Finish(status);
+  }
+
+  Coordinator& coordinator_;
+  std::string job_id_;
+  std::shared_ptr<Link> link_;
+  uint64_t subscription_ = 0;
+  bool subscribed_ = false;
+  v1::JobStatus event_;
+  bool writing_ = false, dirty_ = false, wrote_final_ = false, finished_ = false,
+       cancelled_ = false;
+};
+
+// FetchResult: the EXR in chunks of 1 MiB, one write at a time.
+class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
+ public:
+  FetchReactor(Coordinator& coordinator, const std::string& job_id) {
+    grpc::Status status = handle([&] { exr_ = coordinator.result_exr(job_id); });
+    if (!status.ok()) {
+      Finish(status);
+      return;
+    }
+    write_next();
+  }
+  void OnWriteDone(bool ok) override {
+    if (!ok) {
+      Finish(grpc::Status(grpc::StatusCode::CANCELLED, "fetch cancelled"));
+      return;
+    }
+    write_next();
+  }
+  void OnDone() override { delete this; }
+
+ private:
+  static constexpr size_t kChunkBytes = size_t(1) << 20;
+  void write_next() {
+    if (offset_ >= exr_.size() && offset_ != 0) {
+      Finish(grpc::Status::OK);
+      return;
+    }
+    size_t size = std::min(kChunkBytes, exr_.size() - offset_);
+    chunk_.set_data(exr_.substr(offset_, size));
+    chunk_.set_total_bytes(exr_.size());
+    offset_ += std::max<size_t>(size, 1);
+    StartWrite(&chunk_);
+  }
+  std::string exr_;
+  size_t offset_ = 0;
+  v1::ResultChunk chunk_;
+};
+
+}  // namespace
+
+grpc::ServerUnaryReactor* JobsService::SubmitJob(grpc::CallbackServerContext* context,
+                                                 const v1::SubmitJobRequest* request,
+                                                 v1::SubmitJobResponse* response) {
+  return unary(context, [&] { *response = coordinator_.submit(request->spec()); });
+}
+
+grpc::ServerUnaryReactor* JobsService::GetJob(grpc::CallbackServerContext* context,
+                                              const v1::GetJobRequest* request,
+                                              v1::JobStatus* response) {
+  return unary(context, [&] { *response = coordinator_.status(request->job_id(), true); });
+}
+
+grpc::ServerUnaryReactor* JobsService::ListJobs(grpc::CallbackServerContext* context,
+                                                const v1::ListJobsRequest*,
+                                                v1::ListJobsResponse* response) {
+  return unary(context, [&] {
+    for (v1::JobStatus& job : coordinator_.list()) *response->add_jobs() = std::move(job);
+  });
+}
+
+grpc::ServerWriteReactor<v1::JobStatus>* JobsService::WatchJob(grpc::CallbackServerContext*,
+                                                               const v1::WatchJobRequest* request) {
+  return new WatchReactor(coordinator_, request->job_id());
+}
+
+grpc::ServerUnaryReactor* JobsService::CancelJob(grpc::CallbackServerContext* context,
+                                                 const v1::CancelJobRequest* request,
+                                                 v1::CancelJobResponse* response) {
+  return unary(context, [&] { response->set_state(coordinator_.cancel(request->job_id())); });
+}
+
+grpc::ServerWriteReactor<v1::ResultChunk>* JobsService::FetchResult(
+    grpc::CallbackServerContext*, const v1::FetchResultRequest* request) {
+  return new FetchReactor(coordinator_, request->job_id());
+}
+
+grpc::ServerUnaryReactor* JobsService::ListWorkers(grpc::CallbackServerContext* context,
+                                                   const v1::ListWorkersRequest*,
+                                                   v1::ListWorkersResponse* response) {
+  return unary(context, [&] {
+    for (v1::WorkerInfo& worker : coordinator_.workers())
+      *response->add_workers() = std::move(worker);
+  });
+}
+
+grpc::ServerUnaryReactor* WorkersService::Register(grpc::CallbackServerContext* context,
+                                                   const v1::RegisterRequest* request,
+                                                   v1::RegisterResponse* response) {
+  return unary(context, [&] { *response = coordinator_.register_worker(*request); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::Heartbeat(grpc::CallbackServerContext* context,
+                                                    const v1::HeartbeatRequest* request,
+                                                    v1::HeartbeatResponse* response) {
+  return unary(context, [&] { *response = coordinator_.heartbeat(*request); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::LeaseTasks(grpc::CallbackServerContext* context,
+                                                     const v1::LeaseTasksRequest* request,
+                                                     v1::LeaseTasksResponse* response) {
+  return unary(context, [&] { *response = coordinator_.lease_tasks(*request); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::GetScene(grpc::CallbackServerContext* context,
+                                                   const v1::GetSceneRequest* request,
+                                                   v1::ScenePackage* response) {
+  return unary(context, [&] { *response = coordinator_.scene(request->scene_hash()); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::CompleteTask(grpc::CallbackServerContext* context,
+                                                       const v1::CompleteTaskRequest* request,
+                                                       v1::CompleteTaskResponse* response) {
+  return unary(context, [&] { response->set_accepted(coordinator_.complete_task(*request)); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::FailTask(grpc::CallbackServerContext* context,
+                                                   const v1::FailTaskRequest* request,
+                                                   v1::FailTaskResponse*) {
+  return unary(context, [&] { coordinator_.fail_task(*request); });
+}
+
+}  // namespace penumbra::farm

@@ -1,0 +1,325 @@
+#include "server/store.h"
+
+#include <filesystem>
+#include <stdexcept>
+
+namespace penumbra::farm {
+
+namespace {
+
+const char* kSchema = R"sql(
+CREATE TABLE IF NOT EXISTS scenes (hash TEXT PRIMARY KEY, package BLOB NOT NULL);
+CREATE TABLE IF NOT EXISTS jobs (
+  id INTEGER PRIMARY KEY AUTOINCREMENT, spec BLOB NOT NULL, priority INTEGER NOT NULL,
+  state INTEGER NOT NULL, error TEXT NOT NULL, submitted_ms INTEGER NOT NULL,
+  started_ms INTEGER NOT NULL, finished_ms INTEGER NOT NULL, blocks_opened INTEGER NOT NULL,
+  blocks_sealed INTEGER NOT NULL, compute_seconds REAL NOT NULL, final_errors BLOB NOT NULL,
+  result BLOB);
+CREATE TABLE IF NOT EXISTS task_results (
+  job_id INTEGER NOT NULL, task_index INTEGER NOT NULL, tile BLOB NOT NULL,
+  compute_seconds REAL NOT NULL, PRIMARY KEY (job_id, task_index));
+CREATE TABLE IF NOT EXISTS tiles (
+  job_id INTEGER NOT NULL, tile_index INTEGER NOT NULL, sums BLOB NOT NULL,
+  PRIMARY KEY (job_id, tile_index));
+CREATE TABLE IF NOT EXISTS curve (
+  job_id INTEGER NOT NULL, passes INTEGER NOT NULL, compute_seconds REAL NOT NULL,
+  wall_seconds REAL NOT NULL, mrse REAL NOT NULL, PRIMARY KEY (job_id, passes));
+)sql";
+
+}  // namespace
+
+// A prepared statement with positional binding (1-based) and column access (0-based).
+class Store::Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &statement_, nullptr) != SQLITE_OK)
+      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db) + " in: " + sql);
+  }
+  ~Statement() { sqlite3_finalize(statement_); }
+  Statement& bind(int index, int64_t value) {
+    sqlite3_bind_int64(statement_, index, value);
+    return *this;
+  }
+  Statement& bind(int index, double value) {
+    sqlite3_bind_double(statement_, index, value);
+    return *this;
+  }
+  Statement& bind_text(int index, const std::string& value) {
+    sqlite3_bind_text(statement_, index, value.data(), int(value.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  Statement& bind_blob(int index, const std::string& value) {
+    sqlite3_bind_blob64(statement_, index, value.data(), value.size(), SQLITE_TRANSIENT);
+    return *this;
+  }
+  // True while a row is available.
+  bool step() {
+    int code = sqlite3_step(statement_);
+    if (code == SQLITE_ROW) return true;
+    if (code == SQLITE_DONE) return false;
+    throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db_));
+  }
+  void run() {
+    while (step()) {
+    }
+  }
+  void reset() {
+    sqlite3_reset(statement_);
+    sqlite3_clear_bindings(statement_);
+  }
+  int64_t integer(int column) { return sqlite3_column_int64(statement_, column); }
+  double real(int column) { return sqlite3_column_double(statement_, column); }
+  std::string blob(int column) {
+    const void* data = sqlite3_column_blob(statement_, column);
+    int size = sqlite3_column_bytes(statement_, column);
+    return data ? std::string(static_cast<const char*>(data), size_t(size)) : std::string();
+  }
+  bool is_null(int column) { return sqlite3_column_type(statement_, column) == SQLITE_NULL; }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* statement_ = nullptr;
+};
+
+// BEGIN IMMEDIATE ... COMMIT; rolls back when destroyed without commit().
+class Store::Transaction {
+ public:
+  explicit Transaction(Store& store) : store_(store) { store_.execute("BEGIN IMMEDIATE"); }
+  ~Transaction() {
+    if (!committed_) sqlite3_exec(store_.db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+  void commit() {
+    store_.execute("COMMIT");
+    committed_ = true;
+  }
+
+ private:
+  Store& store_;
+  bool committed_ = false;
+};
+
+Store::Store(const std::string& data_dir) {
+  std::error_code error;
+  std::filesystem::create_directories(data_dir, error);
+  path_ = (std::filesystem::path(data_dir) / "penumbra.sqlite").string();
+  if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
+      SQLITE_OK) {
+    std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    throw std::runtime_error("cannot open " + path_ + ": " + message);
+  }
+  sqlite3_busy_timeout(db_, 10000);
+  execute("PRAGMA journal_mode=WAL");
+  execute("PRAGMA synchronous=FULL");
+  execute(kSchema);
+}
+
+Store::~Store() {
+  sqlite3_close(db_);
+}
+
+void Store::execute(const char* sql) {
+  char* message = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &message) != SQLITE_OK) {
+    std::string text = message ? message : "unknown error";
+    sqlite3_free(message);
+    throw std::runtime_error("sqlite (" + path_ + "): " + text);
+  }
+}
+
+void Store::put_scene(const std::string& hash, const std::string& package) {
+  std::lock_guard lock(mutex_);
+  Statement(db_, "INSERT OR IGNORE INTO scenes (hash, package) VALUES (?, ?)")
+      .bind_text(1, hash)
+      .bind_blob(2, package)
+      .run();
+}
+
+std::optional<std::string> Store::scene(const std::string& hash) {
+  std::lock_guard lock(mutex_);
+  Statement statement(db_, "SELECT package FROM scenes WHERE hash = ?");
+  statement.bind_text(1, hash);
+  if (!statement.step()) return std::nullopt;
+  return statement.blob(0);
+}
+
+uint64_t Store::add_job(const JobRecord& job) {
+  std::lock_guard lock(mutex_);
+  Statement(db_,
+            "INSERT INTO jobs (spec, priority, state, error, submitted_ms, started_ms, "
+            "finished_ms, blocks_opened, blocks_sealed, compute_seconds, final_errors) "
+            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
+      .bind_blob(1, job.spec)
+      .bind(2, int64_t(job.priority))
+      .bind(3, int64_t(job.state))
+      .bind_text(4, job.error)
+      .bind(5, job.submitted_unix_ms)
+      .bind(6, job.started_unix_ms)
+      .bind(7, job.finished_unix_ms)
+      .bind(8, int64_t(job.blocks_opened))
+      .bind(9, int64_t(job.blocks_sealed))
+      .bind(10, job.compute_seconds)
+      .bind_blob(11, job.final_errors)
+      .run();
+  return uint64_t(sqlite3_last_insert_rowid(db_));
+}
+
+void Store::write_job_fields(const JobRecord& job) {
+  Statement(db_,
+            "UPDATE jobs SET state = ?, error = ?, started_ms = ?, finished_ms = ?, "
+            "blocks_opened = ?, blocks_sealed = ?, compute_seconds = ?, final_errors = ? "
+            "WHERE id = ?")
+      .bind(1, int64_t(job.state))
+      .bind_text(2, job.error)
+      .bind(3, job.started_unix_ms)
+      .bind(4, job.finished_unix_ms)
+      .bind(5, int64_t(job.blocks_opened))
+      .bind(6, int64_t(job.blocks_sealed))
+      .bind(7, job.compute_seconds)
+      .bind_blob(8, job.final_errors)
+      .bind(9, int64_t(job.id))
+      .run();
+}
+
+void Store::update_job(const JobRecord& job) {
+  std::lock_guard lock(mutex_);
+  write_job_fields(job);
+}
+
+std::vector<JobRecord> Store::jobs() {
+  std::lock_guard lock(mutex_);
+  Statement statement(db_,
+                      "SELECT id, spec, priority, state, error, submitted_ms, started_ms, "
+                      "finished_ms, blocks_opened, blocks_sealed, compute_seconds, final_errors "
+                      "FROM jobs ORDER BY id");
+  std::vector<JobRecord> jobs;
+  while (statement.step()) {
+    JobRecord job;
+    job.id = uint64_t(statement.integer(0));
+    job.spec = statement.blob(1);
+    job.priority = int(statement.integer(2));
+    job.state = int(statement.integer(3));
+    job.error = statement.blob(4);
+    job.submitted_unix_ms = statement.integer(5);
+    job.started_unix_ms = statement.integer(6);
+    job.finished_unix_ms = statement.integer(7);
+    job.blocks_opened = uint32_t(statement.integer(8));
+    job.blocks_sealed = uint32_t(statement.integer(9));
+    job.compute_seconds = statement.real(10);
+    job.final_errors = statement.blob(11);
+    jobs.push_back(std::move(job));
+  }
+  return jobs;
+}
+
+void Store::add_task_result(const JobRecord& job, const TaskResultRecord& result) {
+  std::lock_guard lock(mutex_);
+  Transaction transaction(*this);
+  Statement(db_,
+            "INSERT OR REPLACE INTO task_results (job_id, task_index, tile, compute_seconds) "
+            "VALUES (?, ?, ?, ?)")
+      .bind(1, int64_t(job.id))
+      .bind(2, int64_t(result.task_index))
+      .bind_blob(3, result.tile)
+      .bind(4, result.compute_seconds)
+      .run();
+  write_job_fields(job);
+  transaction.commit();
+}
+
+std::vector<TaskResultRecord> Store::task_results(uint64_t job_id) {
+  std::lock_guard lock(mutex_);
+  Statement statement(db_,
+                      "SELECT task_index, tile, compute_seconds FROM task_results "
+                      "WHERE job_id = ? ORDER BY task_index");
+  statement.bind(1, int64_t(job_id));
+  std::vector<TaskResultRecord> results;
+  while (statement.step())
+    results.push_back({uint64_t(statement.integer(0)), statement.blob(1), statement.real(2)});
+  return results;
+}
+
+void Store::seal_block(const JobRecord& job, const std::map<uint32_t, std::string>& tiles,
+                       uint64_t first_task, uint64_t end_task,
+                       const std::optional<CurvePoint>& point) {
+  std::lock_guard lock(mutex_);
+  Transaction transaction(*this);
+  {
+    Statement insert(db_,
+                     "INSERT OR REPLACE INTO tiles (job_id, tile_index, sums) VALUES (?, ?, ?)");
+    for (const auto& [tile_index, sums] : tiles) {
+      insert.bind(1, int64_t(job.id)).bind(2, int64_t(tile_index)).bind_blob(3, sums).run();
+      insert.reset();
+    }
+  }
+  Statement(db_, "DELETE FROM task_results WHERE job_id = ? AND task_index >= ? AND task_index < ?")
+      .bind(1, int64_t(job.id))
+      .bind(2, int64_t(first_task))
+      .bind(3, int64_t(end_task))
+      .run();
+  if (point) {
+    Statement(db_,
+              "INSERT OR REPLACE INTO curve (job_id, passes, compute_seconds, wall_seconds, mrse) "
+              "VALUES (?, ?, ?, ?, ?)")
+        .bind(1, int64_t(job.id))
+        .bind(2, int64_t(point->passes))
+        .bind(3, point->compute_seconds)
+        .bind(4, point->wall_seconds)
+        .bind(5, point->mrse)
+        .run();
+  }
+  write_job_fields(job);
+  transaction.commit();
+}
+
+std::map<uint32_t, std::string> Store::tiles(uint64_t job_id) {
+  std::lock_guard lock(mutex_);
+  Statement statement(db_, "SELECT tile_index, sums FROM tiles WHERE job_id = ?");
+  statement.bind(1, int64_t(job_id));
+  std::map<uint32_t, std::string> tiles;
+  while (statement.step()) tiles[uint32_t(statement.integer(0))] = statement.blob(1);
+  return tiles;
+}
+
+std::vector<CurvePoint> Store::curve(uint64_t job_id) {
+  std::lock_guard lock(mutex_);
+  Statement statement(db_,
+                      "SELECT passes, compute_seconds, wall_seconds, mrse FROM curve "
+                      "WHERE job_id = ? ORDER BY passes");
+  statement.bind(1, int64_t(job_id));
+  std::vector<CurvePoint> points;
+  while (statement.step())
+    points.push_back(
+        {uint32_t(statement.integer(0)), statement.real(1), statement.real(2), statement.real(3)});
+  return points;
+}
+
+void Store::finish_job(const JobRecord& job, const std::string& exr) {
+  std::lock_guard lock(mutex_);
+  Transaction transaction(*this);
+  Statement(db_, "UPDATE jobs SET result = ? WHERE id = ?")
+      .bind_blob(1, exr)
+      .bind(2, int64_t(job.id))
+      .run();
+  write_job_fields(job);
+  transaction.commit();
+}
+
+std::optional<std::string> Store::result(uint64_t job_id) {
+  std::lock_guard lock(mutex_);
+  Statement statement(db_, "SELECT result FROM jobs WHERE id = ?");
+  statement.bind(1, int64_t(job_id));
+  if (!statement.step() || statement.is_null(0)) return std::nullopt;
+  return statement.blob(0);
+}
+
+void Store::drop_work(const JobRecord& job) {
+  std::lock_guard lock(mutex_);
+  Transaction transaction(*this);
+  Statement(db_, "DELETE FROM task_results WHERE job_id = ?").bind(1, int64_t(job.id)).run();
+  Statement(db_, "DELETE FROM tiles WHERE job_id = ?").bind(1, int64_t(job.id)).run();
+  write_job_fields(job);
+  transaction.commit();
+}
+
+}  // namespace penumbra::farm

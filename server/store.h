@@ -1,0 +1,97 @@
+#pragma once
+// The coordinator's durable state in SQLite (WAL journal, synchronous=FULL): scenes by content
+// hash, jobs, completed task results of passes not yet sealed, the sealed per-tile sums, the
+// error-versus-time curve and result EXRs. Every write commits before it returns, so whatever a
+// caller acknowledges after a write survives a crash of the process or the machine.
+//
+// The store knows no protobuf and no gRPC: a job's specification is opaque bytes to it.
+
+#include <sqlite3.h>
+
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace penumbra::farm {
+
+struct JobRecord {
+  uint64_t id = 0;
+  std::string spec;  // serialized penumbra.v1.JobSpec (scene by hash, never the package)
+  int priority = 0;
+  int state = 0;  // penumbra.v1.JobState
+  std::string error;
+  int64_t submitted_unix_ms = 0;
+  int64_t started_unix_ms = 0;  // first lease; 0 before
+  int64_t finished_unix_ms = 0;
+  uint32_t blocks_opened = 0;  // pass blocks whose tasks exist
+  uint32_t blocks_sealed = 0;  // pass blocks every tile has completed
+  double compute_seconds = 0;
+  std::string final_errors;  // serialized errors against the reference (opaque)
+};
+
+struct TaskResultRecord {
+  uint64_t task_index = 0;
+  std::string tile;  // serialized TileAccumulator
+  double compute_seconds = 0;
+};
+
+struct CurvePoint {
+  uint32_t passes = 0;
+  double compute_seconds = 0;
+  double wall_seconds = 0;
+  double mrse = 0;
+};
+
+class Store {
+ public:
+  // Opens (creating when needed) data_dir/penumbra.sqlite. Throws std::runtime_error naming the
+  // file when it cannot.
+  explicit Store(const std::string& data_dir);
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  void put_scene(const std::string& hash, const std::string& package);
+  std::optional<std::string> scene(const std::string& hash);
+
+  // Inserts the job and returns its id (ids increase with submission order).
+  uint64_t add_job(const JobRecord& job);
+  // Writes the mutable fields (state, error, times, blocks, compute seconds, final errors).
+  void update_job(const JobRecord& job);
+  std::vector<JobRecord> jobs();
+
+  // Records a completed task and its share of the job's compute seconds, with the job's updated
+  // fields, in one transaction.
+  void add_task_result(const JobRecord& job, const TaskResultRecord& result);
+  std::vector<TaskResultRecord> task_results(uint64_t job_id);
+
+  // Seals a pass block: replaces the job's tile sums with `tiles` (tile index -> serialized
+  // accumulator), deletes the task results with index in [first_task, end_task), appends the
+  // curve point when given, and writes the job's fields; one transaction.
+  void seal_block(const JobRecord& job, const std::map<uint32_t, std::string>& tiles,
+                  uint64_t first_task, uint64_t end_task, const std::optional<CurvePoint>& point);
+  std::map<uint32_t, std::string> tiles(uint64_t job_id);
+  std::vector<CurvePoint> curve(uint64_t job_id);
+
+  // The finished job's EXR and its fields, in one transaction.
+  void finish_job(const JobRecord& job, const std::string& exr);
+  std::optional<std::string> result(uint64_t job_id);
+
+  // Drops what a finished, failed or cancelled job no longer needs (tile sums, task results).
+  void drop_work(const JobRecord& job);
+
+ private:
+  class Statement;
+  class Transaction;
+  void execute(const char* sql);
+  void write_job_fields(const JobRecord& job);
+
+  std::mutex mutex_;
+  sqlite3* db_ = nullptr;
+  std::string path_;
+};
+
+}  // namespace penumbra::farm

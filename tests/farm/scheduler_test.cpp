@@ -1,0 +1,66 @@
+// Scheduler: priorities (higher first), FIFO among equal priorities and within a job, requeued
+// tasks first.
+#include "server/scheduler.h"
+
+#include <gtest/gtest.h>
+
+namespace penumbra::farm {
+namespace {
+
+std::vector<TaskRef> drain(Scheduler& scheduler) {
+  std::vector<TaskRef> order;
+  while (auto task = scheduler.next()) order.push_back(*task);
+  return order;
+}
+
+TEST(Scheduler, HigherPriorityFirstThenSubmissionOrder) {
+  Scheduler scheduler;
+  scheduler.add_job(1, 0, 1);
+  scheduler.add_job(2, 5, 2);
+  scheduler.add_job(3, 0, 3);
+  scheduler.add_job(4, 5, 4);
+  for (uint64_t job : {1, 2, 3, 4})
+    for (uint64_t task : {0, 1}) scheduler.enqueue({job, task});
+  EXPECT_EQ(scheduler.queued_total(), 8u);
+  std::vector<TaskRef> expected = {{2, 0}, {2, 1}, {4, 0}, {4, 1}, {1, 0}, {1, 1}, {3, 0}, {3, 1}};
+  EXPECT_EQ(drain(scheduler), expected);
+  EXPECT_EQ(scheduler.queued_total(), 0u);
+}
+
+TEST(Scheduler, RequeuedTaskGoesFirstWithinItsJob) {
+  Scheduler scheduler;
+  scheduler.add_job(7, 0, 1);
+  for (uint64_t task = 0; task < 3; ++task) scheduler.enqueue({7, task});
+  ASSERT_EQ(scheduler.next(), (TaskRef{7, 0}));
+  scheduler.requeue({7, 0});
+  std::vector<TaskRef> expected = {{7, 0}, {7, 1}, {7, 2}};
+  EXPECT_EQ(drain(scheduler), expected);
+}
+
+TEST(Scheduler, LaterHighPriorityJobOvertakesQueuedWork) {
+  Scheduler scheduler;
+  scheduler.add_job(1, 0, 1);
+  for (uint64_t task = 0; task < 4; ++task) scheduler.enqueue({1, task});
+  ASSERT_EQ(scheduler.next(), (TaskRef{1, 0}));
+  scheduler.add_job(2, 1, 2);
+  scheduler.enqueue({2, 0});
+  EXPECT_EQ(scheduler.next(), (TaskRef{2, 0}));
+  EXPECT_EQ(scheduler.next(), (TaskRef{1, 1}));
+}
+
+TEST(Scheduler, RemovedJobLeavesNothingBehind) {
+  Scheduler scheduler;
+  scheduler.add_job(1, 0, 1);
+  scheduler.add_job(2, 0, 2);
+  scheduler.enqueue({1, 0});
+  scheduler.enqueue({2, 0});
+  scheduler.remove_job(1);
+  EXPECT_EQ(scheduler.queued(1), 0u);
+  EXPECT_EQ(scheduler.queued_total(), 1u);
+  scheduler.requeue({1, 5});  // a late requeue of a removed job is ignored
+  EXPECT_EQ(drain(scheduler), (std::vector<TaskRef>{{2, 0}}));
+  EXPECT_THROW(scheduler.enqueue({9, 0}), std::logic_error);
+}
+
+}  // namespace
+}  // namespace penumbra::farm
