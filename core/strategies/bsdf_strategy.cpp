@@ -7,10 +7,13 @@
 
 namespace penumbra {
 
-BsdfStrategy::BsdfStrategy(const ShadingPoint& sp, const Light& light) : sp_(sp), light_(&light) {}
+BsdfStrategy::BsdfStrategy(const ShadingPoint& sp, const Light& light)
+    : sp_(sp),
+      light_(&light),
+      active_(sp.material != nullptr && light_faces_point(light, sp.position)) {}
 
 std::optional<LightPoint> BsdfStrategy::sample(const Vec2& u) const {
-  if (sp_.material == nullptr) return std::nullopt;
+  if (!active_) return std::nullopt;
   auto bsdf_sample = sample_bsdf(*sp_.material, sp_.normal, sp_.wo, u);
   if (!bsdf_sample) return std::nullopt;
   auto hit = intersect_light(*light_, sp_.position, bsdf_sample->wi, 0.0,
@@ -23,7 +26,7 @@ std::optional<LightPoint> BsdfStrategy::sample(const Vec2& u) const {
 }
 
 double BsdfStrategy::pdf(const Vec3& light_point) const {
-  if (sp_.material == nullptr) return 0;
+  if (!active_) return 0;
   Vec3 d = light_point - sp_.position;
   double r_squared = length_squared(d);
   if (!(r_squared > 0)) return 0;

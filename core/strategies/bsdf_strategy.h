@@ -1,8 +1,11 @@
 #pragma once
-// `bsdf`: BSDF importance sampling (core/materials/bsdf.h) of a direction, traced to the light
-// (either side of it: the back side simply emits nothing). A direction that misses the light is
-// no sample. The solid-angle density converts to area measure as
-// p_area = p_sa |cos(theta_light)| / r^2, and pdf() converts the same way for any point.
+// `bsdf`: BSDF importance sampling (core/materials/bsdf.h) of a direction, traced to the light.
+// A direction that misses the light is no sample. The solid-angle density converts to area
+// measure as p_area = p_sa |cos(theta_light)| / r^2, and pdf() converts the same way.
+//
+// Like the other point strategies, it gives no sample (and density 0) when the shading point is
+// not strictly in front of the light (light_faces_point): the light sends it nothing, and all
+// strategies agree on where the integrand is zero.
 
 #include <optional>
 
@@ -20,6 +23,7 @@ class BsdfStrategy {
  private:
   ShadingPoint sp_;
   const Light* light_;
+  bool active_ = false;  // a material and a light that faces the point
 };
 
 }  // namespace penumbra

@@ -99,6 +99,10 @@ inline Light regular_polygon_light(const Vec3& center, const Vec3& normal, doubl
     vertices.push_back(center + radius * (std::cos(phi) * frame.s + std::sin(phi) * frame.t));
   }
   Light light = polygon_light(vertices);
+  if (dot(light.normal, normal) < 0) {
+    std::reverse(vertices.begin(), vertices.end());
+    light = polygon_light(vertices);
+  }
   return light;
 }
 

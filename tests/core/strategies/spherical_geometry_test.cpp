@@ -1,0 +1,154 @@
+// core/math/spherical_triangle.h and core/math/spherical_rectangle.h: solid angles against
+// closed forms, the defining properties of the parametrizations, inverses and round trips.
+
+#include <gtest/gtest.h>
+
+#include "core/math/spherical_rectangle.h"
+#include "core/math/spherical_triangle.h"
+#include "tests/core/strategies/test_support.h"
+
+namespace penumbra {
+namespace {
+
+using test::relative_difference;
+using test::Rng;
+
+// Solid angle of an a x b rectangle seen from distance d on its central axis.
+double centered_rectangle_solid_angle(double a, double b, double d) {
+  return 4.0 * std::asin(a * b / std::sqrt((a * a + 4 * d * d) * (b * b + 4 * d * d)));
+}
+
+TEST(TriangleSolidAngle, ClosedForms) {
+  EXPECT_NEAR(triangle_solid_angle({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2, 1e-15);
+  EXPECT_NEAR(triangle_solid_angle({3, 0, 0}, {0, 0.5, 0}, {0, 0, 7}), kPi / 2, 1e-15);
+  for (double d : {0.01, 1.0, 40.0}) {
+    double a = 0.7, b = 0.3;
+    Vec3 c00{-a / 2, -b / 2, d}, c10{a / 2, -b / 2, d}, c11{a / 2, b / 2, d}, c01{-a / 2, b / 2, d};
+    double sum = triangle_solid_angle(c00, c10, c11) + triangle_solid_angle(c00, c11, c01);
+    EXPECT_LE(relative_difference(sum, centered_rectangle_solid_angle(a, b, d)), 1e-13) << d;
+  }
+  // 1 cm triangle 40 m away, face on: area / r^2 to first order (relative 1e-8 here).
+  double omega = triangle_solid_angle({0, 0, 40}, {0.01, 0, 40}, {0, 0.01, 40});
+  EXPECT_LE(relative_difference(omega, 0.5e-4 / 1600), 1e-7);
+}
+
+TEST(SphericalTriangle, SubtriangleHasTheRequestedSolidAngleAndSamplesStayInside) {
+  Rng rng(3);
+  for (int trial = 0; trial < 300; ++trial) {
+    Vec3 a = rng.unit_vector(), b = rng.unit_vector(), c = rng.unit_vector();
+    if (trial % 3 == 0) {  // small triangles
+      b = normalize(a + 0.01 * b);
+      c = normalize(a + 0.01 * c);
+    }
+    auto t = SphericalTriangle::prepare(a, b, c);
+    ASSERT_TRUE(t.has_value());
+    double area = t->solid_angle();
+    EXPECT_LE(relative_difference(area, triangle_solid_angle(a, b, c)), 1e-9);
+    for (double xi0 : {0.0, 0.1, 0.5, 0.9, 1.0}) {
+      // xi1 = 1 gives the constructed vertex v2'; (v0, v1, v2') has solid angle xi0 * A.
+      Vec3 v2_prime = t->sample({xi0, 1.0});
+      EXPECT_NEAR(triangle_solid_angle(a, b, v2_prime), xi0 * area, 1e-9 * area);
+      EXPECT_LE(length(t->sample({xi0, 0.0}) - b), 1e-12);
+    }
+    // Inside: on the inner side of the three great circles.
+    double orientation = dot(a, cross(b, c)) > 0 ? 1.0 : -1.0;
+    for (int i = 0; i < 20; ++i) {
+      Vec3 w = t->sample(rng.uniform2());
+      ASSERT_NEAR(length(w), 1.0, 1e-12);
+      double tolerance = 1e-12;
+      EXPECT_GE(orientation * dot(w, cross(a, b)), -tolerance);
+      EXPECT_GE(orientation * dot(w, cross(b, c)), -tolerance);
+      EXPECT_GE(orientation * dot(w, cross(c, a)), -tolerance);
+    }
+  }
+}
+
+TEST(SphericalRectangle, SolidAngleMatchesClosedFormAndTriangles) {
+  for (double d : {1e-4, 0.3, 1.0, 40.0}) {
+    auto r = SphericalRectangle::prepare({0, 0, 0}, {-0.35, -0.15, d}, {0.7, 0, 0}, {0, 0.3, 0});
+    ASSERT_TRUE(r.has_value());
+    EXPECT_LE(relative_difference(r->solid_angle, centered_rectangle_solid_angle(0.7, 0.3, d)),
+              1e-12)
+        << d;
+  }
+  Rng rng(5);
+  for (int trial = 0; trial < 200; ++trial) {
+    Vec3 o = 2.0 * rng.unit_vector();
+    Frame f = Frame::from_normal(rng.unit_vector());
+    Vec3 corner = 0.5 * rng.unit_vector();
+    Vec3 ex = (0.1 + rng.uniform()) * f.s, ey = (0.1 + rng.uniform()) * f.t;
+    auto r = SphericalRectangle::prepare(o, corner, ex, ey);
+    ASSERT_TRUE(r.has_value());
+    double two_triangles = triangle_solid_angle(corner - o, corner + ex - o, corner + ex + ey - o) +
+                           triangle_solid_angle(corner - o, corner + ex + ey - o, corner + ey - o);
+    EXPECT_LE(relative_difference(r->solid_angle, two_triangles), 1e-10);
+  }
+  // The point in the rectangle's plane: no parametrization.
+  EXPECT_FALSE(SphericalRectangle::prepare({0.1, 0.1, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}));
+}
+
+TEST(SphericalRectangle, ParametrizationPropertiesAndInverse) {
+  Rng rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    Vec3 o = 2.0 * rng.unit_vector();
+    Frame f = Frame::from_normal(rng.unit_vector());
+    Vec3 corner = 0.5 * rng.unit_vector();
+    Vec3 ex = (0.1 + rng.uniform()) * f.s, ey = (0.1 + rng.uniform()) * f.t;
+    auto r = SphericalRectangle::prepare(o, corner, ex, ey);
+    ASSERT_TRUE(r.has_value());
+    EXPECT_NEAR(r->line_x(0.0), r->x0, 1e-9 * (r->x1 - r->x0));
+    EXPECT_NEAR(r->line_x(1.0), r->x1, 1e-9 * (r->x1 - r->x0));
+    double previous = r->x0;
+    for (int i = 0; i <= 20; ++i) {
+      double u = i / 20.0;
+      double xu = r->line_x(u);
+      EXPECT_GE(xu, previous - 1e-12);
+      previous = xu;
+      // Step 1's defining property: the sub-rectangle up to the line has solid angle u S.
+      EXPECT_NEAR(r->solid_angle_up_to(xu), u * r->solid_angle, 1e-9 * r->solid_angle);
+    }
+    for (int i = 0; i < 20; ++i) {
+      Vec2 uv = rng.uniform2();
+      Vec3 p = r->sample(uv);
+      // On the rectangle.
+      Vec3 d = p - corner;
+      EXPECT_NEAR(dot(d, normalize(cross(ex, ey))), 0.0, 1e-12);
+      EXPECT_GE(dot(d, ex) / dot(ex, ex), -1e-12);
+      EXPECT_LE(dot(d, ex) / dot(ex, ex), 1 + 1e-12);
+      EXPECT_GE(dot(d, ey) / dot(ey, ey), -1e-12);
+      EXPECT_LE(dot(d, ey) / dot(ey, ey), 1 + 1e-12);
+      // Round trip through the inverse.
+      Vec2 back = r->invert(p);
+      EXPECT_NEAR(back.x, uv.x, 1e-8);
+      EXPECT_NEAR(back.y, uv.y, 1e-8);
+      // h <-> y on the line through the point.
+      Vec2 xy = r->local_xy(p);
+      auto bounds = r->h_bounds(xy.x);
+      double h = SphericalRectangle::h_of_y(bounds.d, xy.y);
+      EXPECT_GE(h, bounds.h0 - 1e-12);
+      EXPECT_LE(h, bounds.h1 + 1e-12);
+      EXPECT_NEAR(r->y_of_h(bounds.d, h), xy.y, 1e-9);
+      EXPECT_LE(length(r->point_at(xy.x, xy.y) - p), 1e-12);
+    }
+  }
+}
+
+TEST(SphericalRectangle, TinyDistantRectangleStaysAccurateAndFinite) {
+  auto r =
+      SphericalRectangle::prepare({0.3, 0.2, 0}, {-0.005, -0.005, 40}, {0.01, 0, 0}, {0, 0.01, 0});
+  ASSERT_TRUE(r.has_value());
+  double approx = 1e-4 * 40 / std::pow(length(Vec3{-0.3, -0.2, 40}), 3);
+  EXPECT_LE(relative_difference(r->solid_angle, approx), 1e-4);
+  Rng rng(9);
+  for (int i = 0; i < 1000; ++i) {
+    Vec2 uv = i < 4 ? Vec2{double(i & 1), double(i >> 1)} : rng.uniform2();
+    Vec3 p = r->sample(uv);
+    ASSERT_TRUE(is_finite(p));
+    EXPECT_NEAR(p.z, 40.0, 1e-12);
+    EXPECT_GE(p.x, -0.005 - 1e-12);
+    EXPECT_LE(p.x, 0.005 + 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace penumbra
