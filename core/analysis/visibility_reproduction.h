@@ -17,6 +17,7 @@ struct VisibilityReproductionOptions {
   int samples = 256;   // N (Fig. 7 uses 256)
   int trials = 20000;  // random discontinuity positions per row (Fig. 7 used 1000)
   uint64_t seed = 2012;
+  int threads = 0;  // worker threads per experiment; 0: the hardware's count
 };
 
 struct VisibilityTable {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <unordered_set>
 
 namespace penumbra {
@@ -209,7 +210,11 @@ std::optional<PredictedError> predicted_squared_error(VisibilityPattern pattern,
   // the others (core/sampling/low_discrepancy.h): jittered stratified sampling.
   if (pattern == VisibilityPattern::Halton) {
     if (!is_power_of_two(samples)) return std::nullopt;
-    pattern = VisibilityPattern::Stratified;
+    auto stratified =
+        predicted_squared_error(VisibilityPattern::Stratified, discontinuities, placement, samples);
+    if (stratified)
+      stratified->source = "as stratified: Owen-scrambled base 2 at N = 2^m; " + stratified->source;
+    return stratified;
   }
 
   if (placement == DiscontinuityPlacement::Independent) {
@@ -267,20 +272,39 @@ VisibilityErrorResult run_visibility_experiment(const VisibilityExperiment& expe
     throw std::invalid_argument("visibility experiment: need at least 2 trials, got " +
                                 std::to_string(experiment.trials));
 
-  // Mean and variance of the squared error over the trials (Welford).
-  std::vector<double> samples(size_t(experiment.samples));
+  // The squared error of every trial, trials split in contiguous blocks over the threads.
+  std::vector<double> squared_errors(size_t(experiment.trials));
+  auto run_trials = [&](int first, int last) {
+    std::vector<double> samples(size_t(experiment.samples));
+    for (int trial = first; trial < last; ++trial) {
+      StreamKey sample_key{experiment.seed, uint64_t(trial), 0, kSampleStream};
+      StreamKey discontinuity_key{experiment.seed, uint64_t(trial), 0, kDiscontinuityStream};
+      VisibilityFunction visibility = random_visibility_function(
+          experiment.discontinuities, experiment.placement, experiment.samples, discontinuity_key);
+      generate_visibility_samples(experiment.pattern, sample_key, samples);
+      double error = visibility.integral() - estimate_visibility_integral(visibility, samples);
+      squared_errors[size_t(trial)] = error * error;
+    }
+  };
+  int threads = experiment.threads > 0 ? experiment.threads
+                                       : int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::clamp(threads, 1, std::max(1, experiment.trials / 256));
+  if (threads == 1) {
+    run_trials(0, experiment.trials);
+  } else {
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t)
+      workers.emplace_back(run_trials, int(int64_t(experiment.trials) * t / threads),
+                           int(int64_t(experiment.trials) * (t + 1) / threads));
+    for (std::thread& worker : workers) worker.join();
+  }
+
+  // Mean and variance of the squared error over the trials (Welford), in trial order.
   double mean = 0, sum_squared_deviation = 0;
-  for (int trial = 0; trial < experiment.trials; ++trial) {
-    StreamKey sample_key{experiment.seed, uint64_t(trial), 0, kSampleStream};
-    StreamKey discontinuity_key{experiment.seed, uint64_t(trial), 0, kDiscontinuityStream};
-    VisibilityFunction visibility = random_visibility_function(
-        experiment.discontinuities, experiment.placement, experiment.samples, discontinuity_key);
-    generate_visibility_samples(experiment.pattern, sample_key, samples);
-    double error = visibility.integral() - estimate_visibility_integral(visibility, samples);
-    double squared_error = error * error;
-    double delta = squared_error - mean;
-    mean += delta / (trial + 1);
-    sum_squared_deviation += delta * (squared_error - mean);
+  for (size_t trial = 0; trial < squared_errors.size(); ++trial) {
+    double delta = squared_errors[trial] - mean;
+    mean += delta / double(trial + 1);
+    sum_squared_deviation += delta * (squared_errors[trial] - mean);
   }
 
   VisibilityErrorResult result;

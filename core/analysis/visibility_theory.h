@@ -103,6 +103,9 @@ struct VisibilityExperiment {
   int samples = 16;    // N
   int trials = 10000;  // random discontinuity positions (and pattern draws)
   uint64_t seed = 1;
+  // Worker threads over the trials (0: the hardware's count). The result does not depend on it:
+  // each trial's error is stored and they are summed in trial order.
+  int threads = 0;
 };
 
 struct VisibilityErrorResult {

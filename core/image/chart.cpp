@@ -223,10 +223,18 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
       pls.scol0(kFirstSeriesColor + i, kSeriesPalette[i].r, kSeriesPalette[i].g,
                 kSeriesPalette[i].b);
 
-    // Axes: the viewport and window alone (axis code -2), then a light grid, then the frame
-    // with ticks and numbers on top ("l": logarithmic labels).
-    pls.col0(kForegroundColor);
-    pls.env(x_axis.low, x_axis.high, y_axis.low, y_axis.high, 0, -2);
+    // The legend goes right of the plot; leave it room for its longest entry (at the legend's
+    // text scale a character is about 5.5 pixels wide on the cairo devices).
+    size_t longest_name = 0;
+    for (const ChartSeries& series : spec.series)
+      longest_name = std::max(longest_name, series.name.size() + (series.fit ? 20 : 0));
+    double legend_fraction =
+        spec.series.empty() ? 0.0 : std::min(0.5, 0.09 + double(longest_name) * 5.5 / spec.width);
+    pls.adv(0);
+    pls.vpor(0.1, 0.96 - legend_fraction, 0.12, 0.9);
+    pls.wind(x_axis.low, x_axis.high, y_axis.low, y_axis.high);
+
+    // Axes: a light grid, then the frame with ticks and numbers on top ("l": logarithmic).
     std::string log_x = spec.log_x ? "l" : "", log_y = spec.log_y ? "l" : "";
     pls.col0(kGridColor);
     pls.width(0.5);
@@ -288,7 +296,7 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
       }
     }
 
-    // Legend inside the top right corner, on a white box.
+    // Legend right of the plot, centred vertically, on a white box.
     if (!legend_texts.empty()) {
       size_t n = legend_texts.size();
       std::vector<const char*> texts, symbols;
@@ -303,12 +311,12 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
       PLFLT legend_width = 0, legend_height = 0;
       pls.col0(kForegroundColor);
       pls.legend(&legend_width, &legend_height, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-                 PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.02, 0.08,
-                 kBackgroundColor, kForegroundColor, kSolidLine, 0, 0, PLINT(n),
-                 legend_options.data(), 1.0, 0.8, 2.0, 0.0, text_colors.data(), texts.data(),
-                 box_colors.data(), box_patterns.data(), box_scales.data(), box_widths.data(),
-                 legend_colors.data(), legend_styles.data(), line_widths.data(),
-                 legend_colors.data(), symbol_scales.data(), symbol_numbers.data(), symbols.data());
+                 PL_POSITION_RIGHT | PL_POSITION_OUTSIDE, 0.02, 0.0, 0.06, kBackgroundColor,
+                 kForegroundColor, kSolidLine, 0, 0, PLINT(n), legend_options.data(), 0.8, 0.7, 2.0,
+                 0.0, text_colors.data(), texts.data(), box_colors.data(), box_patterns.data(),
+                 box_scales.data(), box_widths.data(), legend_colors.data(), legend_styles.data(),
+                 line_widths.data(), legend_colors.data(), symbol_scales.data(),
+                 symbol_numbers.data(), symbols.data());
     }
   }  // ~plstream ends the stream and writes the file.
 

@@ -139,6 +139,14 @@ TEST(VisibilityTheory, ResultsAreDeterministic) {
       VisibilityPattern::Stratified, 3, DiscontinuityPlacement::DistinctStrata, 16, 500, 42};
   EXPECT_EQ(run_visibility_experiment(experiment).mean_squared_error,
             run_visibility_experiment(experiment).mean_squared_error);
+  // The thread count does not change a bit.
+  experiment.trials = 3000;
+  experiment.threads = 1;
+  VisibilityErrorResult one_thread = run_visibility_experiment(experiment);
+  experiment.threads = 3;
+  VisibilityErrorResult three_threads = run_visibility_experiment(experiment);
+  EXPECT_EQ(one_thread.mean_squared_error, three_threads.mean_squared_error);
+  EXPECT_EQ(one_thread.standard_error, three_threads.standard_error);
   experiment.seed = 43;
   VisibilityErrorResult other = run_visibility_experiment(experiment);
   experiment.seed = 42;
