@@ -81,20 +81,23 @@ std::optional<LightPoint> SolidAngleStrategy::sample(const Vec2& u_in) const {
 }
 
 std::optional<LightPoint> SolidAngleStrategy::sample_fan(const Vec2& u) const {
-  // Choose a triangle of the fan by its solid angle, then reuse u.x inside it.
+  // Choose a triangle of the fan by its solid angle, then reuse u.x inside it. Rounding
+  // leftovers (target >= the sum) go to the last triangle with a solid angle.
   double target = u.x * solid_angle_;
-  double begin = 0, omega = 0;
+  double begin = 0, chosen_begin = 0, chosen_omega = 0;
   size_t chosen = fan_triangles_;
   for (size_t i = 0; i < fan_triangles_; ++i) {
-    omega = i < kCachedFanTriangles ? fan_solid_angles_[i] : fan_triangle_solid_angle(i);
-    if (omega > 0) chosen = i;  // the last triangle with solid angle takes rounding leftovers
-    if (omega > 0 && target < begin + omega) break;
+    double omega = i < kCachedFanTriangles ? fan_solid_angles_[i] : fan_triangle_solid_angle(i);
+    if (omega > 0) {
+      chosen = i;
+      chosen_begin = begin;
+      chosen_omega = omega;
+      if (target < begin + omega) break;
+    }
     begin += omega;
   }
   if (chosen == fan_triangles_) return std::nullopt;
-  omega =
-      chosen < kCachedFanTriangles ? fan_solid_angles_[chosen] : fan_triangle_solid_angle(chosen);
-  double u_in_triangle = std::clamp((target - begin) / omega, 0.0, 1.0);
+  double u_in_triangle = std::clamp((target - chosen_begin) / chosen_omega, 0.0, 1.0);
   const std::vector<Vec3>& v = light_->vertices;
   auto triangle = SphericalTriangle::prepare(normalize(v[0] - x_), normalize(v[chosen + 1] - x_),
                                              normalize(v[chosen + 2] - x_));

@@ -86,6 +86,10 @@ std::vector<StrategyCase> cases() {
   add("sa_triangle", Kind::SolidAngle, triangle());
   add("sa_pentagon", Kind::SolidAngle, pentagon());
   add("sa_pentagon_close", Kind::SolidAngle, pentagon())->position = {0.1, 0.7, 0.0};
+  // 20 vertices: more fan triangles than the strategy caches.
+  add("sa_20gon", Kind::SolidAngle,
+      test::regular_polygon_light({0, 1, 0.1}, {0.1, -1, 0.05}, 0.4, 20));
+  add("area_20gon", Kind::Area, test::regular_polygon_light({0, 1, 0.1}, {0.1, -1, 0.05}, 0.4, 20));
   add("sa_disk", Kind::SolidAngle, disk());
   add("sa_disk_oblique", Kind::SolidAngle, disk())->position = {1.5, 0.6, 0.3};
   // Within the radius of the centre: the hemisphere towards the disk bounds it.
