@@ -140,6 +140,19 @@ struct SphericalRectangle {
     return std::clamp(y, y0, y1);
   }
 
+  // Local y of the point a fraction t in [0, 1] along the line (from the edge at y0 to y1), the
+  // parameter a shadow-triangle query along the line reports its visible intervals in.
+  double y_at_fraction(double t) const { return y0 + t * (y1 - y0); }
+
+  // Salesin & Jarosz Eq. 19: the solid-angle density of a point drawn on a line with h uniform
+  // in the union of the line's visible h-intervals, `visible_h_length` their total length and
+  // `line_h_length` = h1 - h0 of the whole line. Equals 1 / S when the line is fully visible.
+  // (Multiply by cos(theta_light) / r^2 for area measure.) 0 for a fully occluded line.
+  double line_sample_solid_angle_pdf(double line_h_length, double visible_h_length) const {
+    if (!(visible_h_length > 0) || !(line_h_length > 0)) return 0;
+    return line_h_length / (solid_angle * visible_h_length);
+  }
+
   // The point of the rectangle at local (x, y), anchored to the corner so that it lies in the
   // rectangle's plane to the precision of the corner.
   Vec3 point_at(double x, double y) const {

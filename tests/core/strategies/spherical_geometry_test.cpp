@@ -133,6 +133,46 @@ TEST(SphericalRectangle, ParametrizationPropertiesAndInverse) {
   }
 }
 
+TEST(SphericalRectangle, LineSamplingDensityIntegratesToOneOverVisibleParts) {
+  // Salesin & Jarosz Eq. 16-19 with one occluded interval per line: line x = line_x(u) with u
+  // uniform, h uniform in the visible h-intervals. Integrating the density (converted to area
+  // measure) over the visible part of the rectangle, line by line, must give 1 for every
+  // occlusion pattern that leaves every line some visible part.
+  auto r = SphericalRectangle::prepare({0.2, -0.1, 0}, {-0.4, -0.3, 0.8}, {0.9, 0, 0}, {0, 0.7, 0});
+  ASSERT_TRUE(r.has_value());
+  EXPECT_NEAR(r->line_sample_solid_angle_pdf(0.3, 0.3), 1.0 / r->solid_angle, 1e-15);
+  EXPECT_EQ(r->line_sample_solid_angle_pdf(0.3, 0.0), 0.0);
+  // Occluder: the band t in [0.3, 0.55] of every line, shifted with x.
+  auto occluded = [&](double x_fraction, double t) {
+    double shift = 0.2 * x_fraction;
+    return t > 0.3 + shift && t < 0.55 + shift;
+  };
+  int nx = 400, ny = 400;
+  double total = 0;
+  double dx = (r->x1 - r->x0) / nx, dy = (r->y1 - r->y0) / ny;
+  for (int i = 0; i < nx; ++i) {
+    double x = r->x0 + (i + 0.5) * dx;
+    double x_fraction = (i + 0.5) / nx;
+    auto bounds = r->h_bounds(x);
+    // Visible h-length: the whole line minus the occluded band's h-interval.
+    double ya = r->y_at_fraction(0.3 + 0.2 * x_fraction),
+           yb = r->y_at_fraction(0.55 + 0.2 * x_fraction);
+    double visible = (bounds.h1 - bounds.h0) - (SphericalRectangle::h_of_y(bounds.d, yb) -
+                                                SphericalRectangle::h_of_y(bounds.d, ya));
+    for (int j = 0; j < ny; ++j) {
+      double t = (j + 0.5) / ny;
+      if (occluded(x_fraction, t)) continue;
+      double y = r->y_at_fraction(t);
+      Vec3 d{x, y, r->z0};
+      double r2 = length_squared(d);
+      double area_pdf = r->line_sample_solid_angle_pdf(bounds.h1 - bounds.h0, visible) * (-r->z0) /
+                        (r2 * std::sqrt(r2));
+      total += area_pdf * dx * dy;
+    }
+  }
+  EXPECT_NEAR(total, 1.0, 2e-3);
+}
+
 TEST(SphericalRectangle, TinyDistantRectangleStaysAccurateAndFinite) {
   auto r =
       SphericalRectangle::prepare({0.3, 0.2, 0}, {-0.005, -0.005, 40}, {0.01, 0, 0}, {0, 0.01, 0});
