@@ -81,7 +81,7 @@ VisibilityTable reproduce_one_discontinuity(const VisibilityReproductionOptions&
   VisibilityTable table{"Fig. 4: one discontinuity (N = " + std::to_string(options.samples) + ")",
                         {}};
   for (VisibilityPattern pattern :
-       {Uniform, UniformJitter, Stratified, Halton, CanonicalHalton, Random})
+       {StratumEnds, Uniform, UniformJitter, Stratified, Halton, CanonicalHalton, Random})
     table.rows.push_back(run(options, pattern, 1, DistinctStrata));
   return table;
 }

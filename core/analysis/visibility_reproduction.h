@@ -25,8 +25,9 @@ struct VisibilityTable {
   std::vector<VisibilityErrorResult> rows;
 };
 
-// Fig. 4: one discontinuity: uniform 1/(12N^2), stratified and uniform jitter 1/(6N^2), the
-// canonical Halton sequence near the end-point case 1/(3N^2), random 1/(6N).
+// Fig. 4: one discontinuity: samples at the strata's end-points 1/(3N^2), uniform 1/(12N^2),
+// stratified and uniform jitter 1/(6N^2), the canonical Halton sequence near the end-point
+// case, random 1/(6N).
 VisibilityTable reproduce_one_discontinuity(const VisibilityReproductionOptions& options);
 // Fig. 6: two discontinuities in different strata: uniform and uniform jitter 1/(6N^2),
 // stratified 1/(3N^2); random (independent placement) 1/(6N).

@@ -81,6 +81,8 @@ std::string_view visibility_pattern_name(VisibilityPattern pattern) {
       return "random";
     case VisibilityPattern::CanonicalHalton:
       return "halton-canonical";
+    case VisibilityPattern::StratumEnds:
+      return "stratum-ends";
   }
   return "unknown";
 }
@@ -98,6 +100,7 @@ std::optional<Pattern> renderer_pattern(VisibilityPattern pattern) {
     case VisibilityPattern::Random:
       return Pattern::Random;
     case VisibilityPattern::CanonicalHalton:
+    case VisibilityPattern::StratumEnds:
       return std::nullopt;
   }
   return std::nullopt;
@@ -172,8 +175,11 @@ void generate_visibility_samples(VisibilityPattern pattern, const StreamKey& key
     generate_1d(*renderer, key, out);
     return;
   }
-  // The paper's Halton points h(1), ..., h(N): deterministic, the same for every trial.
-  for (size_t i = 0; i < out.size(); ++i) out[i] = radical_inverse_base2(uint32_t(i + 1));
+  // Deterministic, the same for every trial: the paper's Halton points h(1), ..., h(N), or the
+  // strata's left end-points i/N.
+  for (size_t i = 0; i < out.size(); ++i)
+    out[i] = pattern == VisibilityPattern::StratumEnds ? double(i) / double(out.size())
+                                                       : radical_inverse_base2(uint32_t(i + 1));
 }
 
 double estimate_visibility_integral(const VisibilityFunction& visibility,
@@ -259,6 +265,11 @@ std::optional<PredictedError> predicted_squared_error(VisibilityPattern pattern,
                             "(k/12 + [k odd](1-k/N)/4 + [k even](k/N)/4)/N^2",
                             "Eq. 11 with a = 0 (Sec. 4.1, Fig. 3), N = 2^m"};
     }
+    case VisibilityPattern::StratumEnds:
+      // a = 0 in every stratum: variance 1/12 and mean 1/2 per term, the alternating means
+      // leave 1/4 for an odd k. k = 1: 1/(3N^2), Fig. 4's end-points row.
+      return PredictedError{(k / 12.0 + (odd ? 0.25 : 0.0)) / n2, "(k/12 + [k odd]/4)/N^2",
+                            "Fig. 4 (k=1), Eq. 11 with a = 0"};
     case VisibilityPattern::Halton:
     case VisibilityPattern::Random:
       break;

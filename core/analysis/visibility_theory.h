@@ -21,20 +21,22 @@
 namespace penumbra {
 
 // The sample patterns of the experiments: the renderer's patterns (core/sampling/pattern.h), and
-// the paper's canonical, unrandomized Halton sequence (radical inverse base 2 of 1..N, "[1/2,
-// 1/4, 3/4, 1/8]", Sec. 4.1), which the renderer does not use because it is the same for every
-// pixel.
+// two deterministic ones of the paper the renderer does not use (they are the same for every
+// pixel): the canonical, unrandomized Halton sequence (radical inverse base 2 of 1..N, "[1/2,
+// 1/4, 3/4, 1/8]", Sec. 4.1) and samples at the end-points of the strata, i/N (Fig. 4's worst
+// placement).
 enum class VisibilityPattern {
   Uniform,
   UniformJitter,
   Stratified,
   Halton,
   Random,
-  CanonicalHalton
+  CanonicalHalton,
+  StratumEnds
 };
 
 std::string_view visibility_pattern_name(VisibilityPattern pattern);
-// The renderer's pattern behind a visibility pattern; empty for CanonicalHalton.
+// The renderer's pattern behind a visibility pattern; empty for CanonicalHalton and StratumEnds.
 std::optional<Pattern> renderer_pattern(VisibilityPattern pattern);
 
 // How the k discontinuities of a trial are placed.

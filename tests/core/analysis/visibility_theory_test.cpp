@@ -122,6 +122,8 @@ TEST(VisibilityPatterns, CanonicalHaltonIsThePapersSequence) {
   std::vector<double> points(4);
   generate_visibility_samples(VisibilityPattern::CanonicalHalton, {}, points);
   EXPECT_EQ(points, (std::vector<double>{0.5, 0.25, 0.75, 0.125}));  // Sec. 4.1
+  generate_visibility_samples(VisibilityPattern::StratumEnds, {}, points);
+  EXPECT_EQ(points, (std::vector<double>{0.0, 0.25, 0.5, 0.75}));
 }
 
 TEST(VisibilityTheory, NoDiscontinuityHasNoError) {
@@ -153,14 +155,15 @@ TEST(VisibilityTheory, ResultsAreDeterministic) {
   EXPECT_NE(other.mean_squared_error, run_visibility_experiment(experiment).mean_squared_error);
 }
 
-// Fig. 4: uniform 1/(12N^2), stratified and uniform jitter 1/(6N^2), canonical Halton close to
-// the end-point case, random 1/(6N).
+// Fig. 4: end-points 1/(3N^2), uniform 1/(12N^2), stratified and uniform jitter 1/(6N^2), canonical
+// Halton close to the end-point case, random 1/(6N).
 TEST(VisibilityTheory, OneDiscontinuityMatchesFig4) {
   VisibilityReproductionOptions options{32, 20000, 4};
   VisibilityTable table = reproduce_one_discontinuity(options);
-  ASSERT_EQ(table.rows.size(), 6u);
+  ASSERT_EQ(table.rows.size(), 7u);
   for (const auto& row : table.rows) expect_matches_prediction(row);
   double n2 = 32.0 * 32.0;
+  EXPECT_DOUBLE_EQ(find_row(table, VisibilityPattern::StratumEnds).predicted->value, 1 / (3 * n2));
   EXPECT_DOUBLE_EQ(find_row(table, VisibilityPattern::Uniform).predicted->value, 1 / (12 * n2));
   EXPECT_DOUBLE_EQ(find_row(table, VisibilityPattern::Stratified).predicted->value, 1 / (6 * n2));
   EXPECT_DOUBLE_EQ(find_row(table, VisibilityPattern::UniformJitter).predicted->value,
