@@ -1,0 +1,390 @@
+#include "worker/worker.h"
+
+#include <grpcpp/create_channel.h>
+#include <grpcpp/security/credentials.h>
+#include <spdlog/spdlog.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/render/local_render.h"
+#include "core/sampling/pattern.h"
+#include "penumbra/version.h"
+#include "proto/support/scene_packing.h"
+
+namespace penumbra::farm {
+
+namespace {
+
+constexpr size_t kMaxRenderers = 4;
+
+std::unique_ptr<grpc::ClientContext> context_with_deadline(std::chrono::seconds seconds) {
+  auto context = std::make_unique<grpc::ClientContext>();
+  context->set_deadline(std::chrono::system_clock::now() + seconds);
+  return context;
+}
+
+bool is_hex_hash(const std::string& text) {
+  return !text.empty() && text.size() <= 128 && std::all_of(text.begin(), text.end(), [](char c) {
+    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+  });
+}
+
+std::string describe(const grpc::Status& status) {
+  return "status " + std::to_string(int(status.error_code())) + ": " + status.error_message();
+}
+
+}  // namespace
+
+RenderWorker::RenderWorker(WorkerOptions options) : options_(std::move(options)) {
+  if (options_.threads < 1) options_.threads = 1;
+  if (options_.build_flavour.empty()) options_.build_flavour = kBuildFlavour;
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(1 << 30);
+  arguments.SetMaxSendMessageSize(1 << 30);
+  // Reconnect quickly when the coordinator comes back (the default waits up to two minutes).
+  arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
+  arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
+  arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
+  channel_ = grpc::CreateCustomChannel(options_.coordinator, grpc::InsecureChannelCredentials(),
+                                       arguments);
+  stub_ = v1::Workers::NewStub(channel_);
+}
+
+RenderWorker::~RenderWorker() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (render_thread_.joinable()) render_thread_.join();
+}
+
+void RenderWorker::drain() {
+  draining_ = true;
+  wake_.notify_all();
+}
+
+void RenderWorker::backoff() {
+  backoff_ = std::clamp(backoff_ * 2, std::chrono::milliseconds(100), options_.max_backoff);
+  std::unique_lock lock(mutex_);
+  wake_.wait_for(lock, backoff_, [this] { return stopping_; });
+}
+
+int RenderWorker::run() {
+  render_thread_ = std::thread([this] { render_loop(); });
+  std::optional<std::chrono::steady_clock::time_point> drain_deadline;
+  int exit_code = 0;
+  while (true) {
+    if (draining_ && !drain_deadline) {
+      drain_deadline = std::chrono::steady_clock::now() + options_.drain_timeout;
+      spdlog::info("draining: finishing the tasks held, then exiting");
+    }
+    bool ok = true;
+    if (worker_id_.empty()) {
+      v1::RegisterRequest request;
+      request.set_name(options_.name);
+      request.set_threads(uint32_t(options_.threads));
+      request.set_version(kVersion);
+      request.set_build_flavour(options_.build_flavour);
+      request.set_protocol_version(v1::PROTOCOL_VERSION_CURRENT);
+      v1::RegisterResponse response;
+      auto context = context_with_deadline(std::chrono::seconds(10));
+      grpc::Status status = stub_->Register(context.get(), request, &response);
+      if (status.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
+          status.error_code() == grpc::StatusCode::INVALID_ARGUMENT) {
+        spdlog::critical("the coordinator refused this worker: {}", status.error_message());
+        exit_code = 2;
+        break;
+      }
+      if (status.ok()) {
+        worker_id_ = response.worker_id();
+        heartbeat_period_ = std::chrono::duration<double>(response.heartbeat_seconds());
+        last_heartbeat_ = std::chrono::steady_clock::now();
+        spdlog::info("registered with {} as {}", options_.coordinator, worker_id_);
+      } else {
+        spdlog::debug("coordinator {} unavailable ({}); retrying", options_.coordinator,
+                      describe(status));
+        ok = false;
+      }
+    }
+    if (ok && !worker_id_.empty()) ok = deliver_outbox();
+    if (ok && !worker_id_.empty() &&
+        std::chrono::steady_clock::now() - last_heartbeat_ >= heartbeat_period_)
+      ok = send_heartbeat();
+    bool leased = false;
+    if (draining_) {
+      std::lock_guard lock(mutex_);
+      if (queue_.empty() && !rendering_ && outbox_.empty()) break;
+      if (std::chrono::steady_clock::now() > *drain_deadline) {
+        spdlog::warn("drain timed out with {} results undelivered", outbox_.size());
+        break;
+      }
+    } else if (ok && !worker_id_.empty()) {
+      size_t before = 0;
+      {
+        std::lock_guard lock(mutex_);
+        before = queue_.size();
+      }
+      ok = lease_more();
+      std::lock_guard lock(mutex_);
+      leased = queue_.size() > before;
+    }
+    if (!ok) {
+      backoff();
+      continue;
+    }
+    reset_backoff();
+    if (!leased) {
+      std::unique_lock lock(mutex_);
+      wake_.wait_for(lock, options_.idle_poll);
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    queue_.clear();
+  }
+  wake_.notify_all();
+  render_thread_.join();
+  spdlog::info("worker {} stopped", worker_id_);
+  return exit_code;
+}
+
+bool RenderWorker::deliver_outbox() {
+  while (true) {
+    Outgoing outgoing;
+    {
+      std::lock_guard lock(mutex_);
+      if (outbox_.empty()) return true;
+      outgoing = outbox_.front();
+    }
+    grpc::Status status;
+    bool accepted = true;
+    if (outgoing.completion) {
+      outgoing.completion->set_worker_id(worker_id_);
+      v1::CompleteTaskResponse response;
+      auto context = context_with_deadline(std::chrono::seconds(30));
+      status = stub_->CompleteTask(context.get(), *outgoing.completion, &response);
+      accepted = response.accepted();
+    } else {
+      outgoing.failure->set_worker_id(worker_id_);
+      v1::FailTaskResponse response;
+      auto context = context_with_deadline(std::chrono::seconds(10));
+      status = stub_->FailTask(context.get(), *outgoing.failure, &response);
+    }
+    bool transient = status.error_code() == grpc::StatusCode::UNAVAILABLE ||
+                     status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED ||
+                     status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
+    if (transient) {
+      spdlog::debug("result undelivered ({}); kept for retry", describe(status));
+      return false;
+    }
+    if (!status.ok())
+      spdlog::error("result dropped: the coordinator rejected it: {}", describe(status));
+    else if (!accepted)
+      spdlog::info("{} task {}: result dropped by the coordinator (lease expired or duplicate)",
+                   outgoing.completion->job_id(), outgoing.completion->task_index());
+    std::lock_guard lock(mutex_);
+    if (!outbox_.empty() && outbox_.front().token() == outgoing.token()) outbox_.pop_front();
+  }
+}
+
+bool RenderWorker::send_heartbeat() {
+  v1::HeartbeatRequest request;
+  request.set_worker_id(worker_id_);
+  {
+    std::lock_guard lock(mutex_);
+    for (const HeldTask& held : queue_) request.add_attempt_tokens(held.task.attempt_token());
+    if (rendering_) request.add_attempt_tokens(rendering_->task.attempt_token());
+    for (const Outgoing& outgoing : outbox_) request.add_attempt_tokens(outgoing.token());
+  }
+  v1::HeartbeatResponse response;
+  auto context = context_with_deadline(std::chrono::seconds(10));
+  grpc::Status status = stub_->Heartbeat(context.get(), request, &response);
+  if (status.error_code() == grpc::StatusCode::NOT_FOUND) {
+    // The coordinator no longer knows us (it restarted): our leases are gone with it.
+    spdlog::warn("coordinator forgot worker {}; registering again", worker_id_);
+    worker_id_.clear();
+    std::lock_guard lock(mutex_);
+    queue_.clear();
+    if (rendering_) rendering_->revoked = true;
+    return true;
+  }
+  if (!status.ok()) return false;
+  last_heartbeat_ = std::chrono::steady_clock::now();
+  if (response.revoked_tokens_size() == 0) return true;
+  std::lock_guard lock(mutex_);
+  for (const std::string& token : response.revoked_tokens()) {
+    std::erase_if(queue_, [&](const HeldTask& held) { return held.task.attempt_token() == token; });
+    if (rendering_ && rendering_->task.attempt_token() == token) rendering_->revoked = true;
+  }
+  spdlog::info("{} leases revoked by the coordinator", response.revoked_tokens_size());
+  return true;
+}
+
+bool RenderWorker::lease_more() {
+  // Hold one task more than can render at once, so the next one is ready when one finishes.
+  const size_t capacity = size_t(std::max(options_.threads, 2));
+  size_t held = 0;
+  {
+    std::lock_guard lock(mutex_);
+    held = queue_.size() + (rendering_ ? 1 : 0);
+  }
+  if (held >= capacity) return true;
+  v1::LeaseTasksRequest request;
+  request.set_worker_id(worker_id_);
+  request.set_max_tasks(uint32_t(capacity - held));
+  v1::LeaseTasksResponse response;
+  auto context = context_with_deadline(std::chrono::seconds(10));
+  grpc::Status status = stub_->LeaseTasks(context.get(), request, &response);
+  if (status.error_code() == grpc::StatusCode::NOT_FOUND) {
+    worker_id_.clear();
+    return true;
+  }
+  if (!status.ok()) return false;
+  if (response.tasks_size() == 0) return true;
+  {
+    std::lock_guard lock(mutex_);
+    for (const v1::Task& task : response.tasks()) queue_.push_back({task, false});
+  }
+  wake_.notify_all();
+  return true;
+}
+
+void RenderWorker::render_loop() {
+  tbb::task_arena arena(options_.threads);
+  while (true) {
+    v1::Task task;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      rendering_ = queue_.front();
+      queue_.pop_front();
+      task = rendering_->task;
+    }
+    Outgoing outgoing;
+    try {
+      std::shared_ptr<const Renderer> renderer = renderer_for(task);
+      TileRect rect{task.tile().x0(), task.tile().y0(), task.tile().x1(), task.tile().y1()};
+      TileAccumulator accumulator(rect);
+      double cpu_start = process_cpu_seconds();
+      arena.execute(
+          [&] { renderer->render_tile(rect, task.pass_begin(), task.pass_end(), accumulator); });
+      v1::CompleteTaskRequest completion;
+      completion.set_job_id(task.job_id());
+      completion.set_task_index(task.task_index());
+      completion.set_attempt_token(task.attempt_token());
+      completion.set_tile(accumulator.serialize());
+      completion.set_compute_seconds(std::max(0.0, process_cpu_seconds() - cpu_start));
+      outgoing.completion = std::move(completion);
+    } catch (const std::exception& error) {
+      spdlog::error("{} task {}: {}", task.job_id(), task.task_index(), error.what());
+      v1::FailTaskRequest failure;
+      failure.set_job_id(task.job_id());
+      failure.set_task_index(task.task_index());
+      failure.set_attempt_token(task.attempt_token());
+      failure.set_error(error.what());
+      outgoing.failure = std::move(failure);
+    }
+    {
+      std::lock_guard lock(mutex_);
+      if (!rendering_->revoked) outbox_.push_back(std::move(outgoing));
+      rendering_.reset();
+    }
+    wake_.notify_all();
+  }
+}
+
+std::shared_ptr<const Scene> RenderWorker::scene_for(const std::string& hash) {
+  {
+    std::lock_guard lock(cache_mutex_);
+    auto it = scenes_.find(hash);
+    if (it != scenes_.end()) return it->second;
+  }
+  if (!is_hex_hash(hash)) throw std::runtime_error("scene hash \"" + hash + "\" is not hex");
+  v1::ScenePackage package;
+  bool have_package = false;
+  std::filesystem::path cached;
+  if (!options_.cache_dir.empty()) {
+    cached = std::filesystem::path(options_.cache_dir) / "scenes" / (hash + ".pb");
+    std::ifstream in(cached, std::ios::binary);
+    have_package = in && package.ParseFromIstream(&in);
+  }
+  std::optional<Scene> scene;
+  if (have_package) {
+    try {
+      scene = parse_wire_package(package);
+      if (scene->content_hash != hash) scene.reset();
+    } catch (const std::exception& error) {
+      spdlog::warn("cached scene {} unusable ({}); fetching it again", hash, error.what());
+    }
+  }
+  if (!scene) {
+    grpc::Status status;
+    for (int attempt = 0; attempt < 20; ++attempt) {
+      v1::GetSceneRequest request;
+      request.set_scene_hash(hash);
+      package.Clear();
+      auto context = context_with_deadline(std::chrono::seconds(60));
+      status = stub_->GetScene(context.get(), request, &package);
+      if (status.ok() || (status.error_code() != grpc::StatusCode::UNAVAILABLE &&
+                          status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED))
+        break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100 * (1 << std::min(attempt, 4))));
+    }
+    if (!status.ok())
+      throw std::runtime_error("cannot fetch scene " + hash + ": " + describe(status));
+    scene = parse_wire_package(package);
+    if (scene->content_hash != hash)
+      throw std::runtime_error("scene " + hash + " arrived with hash " + scene->content_hash);
+    if (!cached.empty()) {
+      std::error_code error;
+      std::filesystem::create_directories(cached.parent_path(), error);
+      auto temporary = cached;
+      temporary += ".tmp";
+      {
+        std::ofstream out(temporary, std::ios::binary);
+        package.SerializeToOstream(&out);
+      }
+      std::filesystem::rename(temporary, cached, error);
+    }
+    spdlog::info("scene {} ({}) fetched", scene->name, hash.substr(0, 12));
+  }
+  auto shared = std::make_shared<const Scene>(std::move(*scene));
+  std::lock_guard lock(cache_mutex_);
+  scenes_[hash] = shared;
+  return shared;
+}
+
+std::shared_ptr<const Renderer> RenderWorker::renderer_for(const v1::Task& task) {
+  std::ostringstream key;
+  key << task.job_id() << '|' << task.scene_hash() << '|' << task.method() << '|' << task.sampler()
+      << '|' << task.seed();
+  {
+    std::lock_guard lock(cache_mutex_);
+    auto it = renderers_.find(key.str());
+    if (it != renderers_.end()) return it->second;
+  }
+  RenderOptions render_options;
+  render_options.method = task.method();
+  auto pattern = parse_pattern(task.sampler());
+  if (!pattern) throw std::runtime_error("unknown sampler \"" + task.sampler() + "\"");
+  render_options.sampler = *pattern;
+  render_options.seed = task.seed();
+  auto renderer = std::make_shared<const Renderer>(scene_for(task.scene_hash()), render_options);
+  std::lock_guard lock(cache_mutex_);
+  renderers_[key.str()] = renderer;
+  renderer_order_.push_back(key.str());
+  while (renderer_order_.size() > kMaxRenderers) {
+    renderers_.erase(renderer_order_.front());
+    renderer_order_.pop_front();
+  }
+  return renderer;
+}
+
+}  // namespace penumbra::farm

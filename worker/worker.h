@@ -1,0 +1,98 @@
+#pragma once
+// The worker daemon's core: registers with the coordinator, leases as many tasks as it has
+// threads (so one is always waiting while another renders), renders them with core in a TBB
+// arena of `threads`, heartbeats its leases, and delivers results, keeping those it could not
+// deliver and retrying them. Scenes are fetched by content hash and cached on disk and in memory;
+// a job's Renderer is kept across its tiles. When the coordinator is away it retries with
+// backoff (it may start before the coordinator). drain() stops leasing, finishes what it holds,
+// delivers it and returns from run().
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/render/renderer.h"
+#include "penumbra/v1/farm.grpc.pb.h"
+
+namespace penumbra::farm {
+
+struct WorkerOptions {
+  std::string coordinator = "127.0.0.1:7420";
+  int threads = 1;
+  std::string cache_dir;  // empty: scenes are cached in memory only
+  std::string name = "worker";
+  std::string build_flavour;  // empty: penumbra::kBuildFlavour
+  std::chrono::milliseconds idle_poll{100};
+  std::chrono::milliseconds max_backoff{2000};
+  std::chrono::seconds drain_timeout{60};
+};
+
+class RenderWorker {
+ public:
+  explicit RenderWorker(WorkerOptions options);
+  ~RenderWorker();
+  RenderWorker(const RenderWorker&) = delete;
+  RenderWorker& operator=(const RenderWorker&) = delete;
+
+  // Works until drained (returns 0) or refused by the coordinator (returns 2: wrong build or
+  // protocol; the reason is logged).
+  int run();
+  // Stops leasing; run() returns once held tasks are rendered and delivered (or drain_timeout).
+  void drain();
+
+ private:
+  struct HeldTask {
+    v1::Task task;
+    bool revoked = false;
+  };
+  struct Outgoing {
+    std::optional<v1::CompleteTaskRequest> completion;
+    std::optional<v1::FailTaskRequest> failure;
+    const std::string& token() const {
+      return completion ? completion->attempt_token() : failure->attempt_token();
+    }
+  };
+
+  bool register_with_coordinator();
+  bool deliver_outbox();
+  bool send_heartbeat();
+  bool lease_more();
+  void render_loop();
+  void render(const v1::Task& task);
+  std::shared_ptr<const Scene> scene_for(const std::string& hash);
+  std::shared_ptr<const Renderer> renderer_for(const v1::Task& task);
+  void backoff();
+  void reset_backoff() { backoff_ = std::chrono::milliseconds(0); }
+
+  WorkerOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Workers::Stub> stub_;
+  std::string worker_id_;
+  std::chrono::duration<double> heartbeat_period_{1.0};
+  std::chrono::steady_clock::time_point last_heartbeat_;
+  std::chrono::milliseconds backoff_{0};
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<HeldTask> queue_;         // leased, not yet rendering
+  std::optional<HeldTask> rendering_;  // the task being rendered
+  std::deque<Outgoing> outbox_;        // results not yet delivered
+  std::atomic<bool> draining_{false};
+  bool stopping_ = false;
+  std::thread render_thread_;
+
+  std::mutex cache_mutex_;
+  std::map<std::string, std::shared_ptr<const Scene>> scenes_;
+  std::map<std::string, std::shared_ptr<const Renderer>> renderers_;  // by job and options
+  std::deque<std::string> renderer_order_;
+};
+
+}  // namespace penumbra::farm
