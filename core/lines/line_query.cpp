@@ -91,39 +91,38 @@ Vec3 absolute(const Vec3& v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Traversal: a linear function f(p) = dot(gradient, p) + offset evaluated over four boxes at
-// once, as a conservative range [lower, upper] that contains the exact range over each box.
+// Traversal: a linear function f(p) = dot(gradient, p) + offset over four boxes at once, as
+// its value at the centres (`middle`) and a radius: [middle - radius, middle + radius] contains
+// the exact range of f over each box.
 
-struct BoxRange4 {
-  __m128 gradient[3];
-  __m128 offset_lower, offset_upper;  // offset -+ the float error bound
-  int lower_corner[3];                // per axis: 0 = take the box's lower bound, 1 = upper
+struct LinearRange4 {
+  __m128 gradient[3], gradient_magnitude[3];
+  __m128 offset, error;
 
-  BoxRange4(const Vec3& gradient_d, const Vec3& x, const Vec3& scene_max_abs) {
-    double offset = -dot(gradient_d, x);
-    // Float error of evaluating dot(g, p) + offset with g, offset, p rounded to float: a few
-    // ulps of the largest partial sum, bounded by |g|.(max |p| + |x|); 32 ulps to be safe.
-    double error =
-        32 * (FLT_EPSILON / 2) *
-        (dot(absolute(gradient_d), scene_max_abs) + dot(absolute(gradient_d), absolute(x)));
+  LinearRange4(const Vec3& gradient_d, const Vec3& x, const Vec3& scene_max_abs) {
+    double offset_d = -dot(gradient_d, x);
+    // Float error of evaluating dot(g, c) + offset and dot(|g|, e) with g, offset, c, e rounded
+    // to float: a few ulps of the largest partial sum, bounded by |g|.(max |p| + |x|) since
+    // centres and extents are bounded by the scene's extent; 32 ulps to be safe.
+    Vec3 magnitude = absolute(gradient_d);
+    double error_d =
+        32 * (FLT_EPSILON / 2) * (dot(magnitude, scene_max_abs) + dot(magnitude, absolute(x)));
     for (int k = 0; k < 3; ++k) {
       gradient[k] = _mm_set1_ps(static_cast<float>(gradient_d[k]));
-      lower_corner[k] = gradient_d[k] >= 0 ? 0 : 1;
+      gradient_magnitude[k] = _mm_set1_ps(static_cast<float>(magnitude[k]));
     }
-    offset_lower = _mm_set1_ps(round_down(offset - error));
-    offset_upper = _mm_set1_ps(round_up(offset + error));
+    offset = _mm_set1_ps(static_cast<float>(offset_d));
+    error = _mm_set1_ps(static_cast<float>(error_d));
   }
 
-  void evaluate(const LineQuery::Node& node, __m128& lower, __m128& upper) const {
-    __m128 lo = offset_lower, hi = offset_upper;
-    for (int k = 0; k < 3; ++k) {
-      __m128 near = _mm_load_ps(node.bounds[lower_corner[k]][k]);
-      __m128 far = _mm_load_ps(node.bounds[1 - lower_corner[k]][k]);
-      lo = _mm_add_ps(lo, _mm_mul_ps(gradient[k], near));
-      hi = _mm_add_ps(hi, _mm_mul_ps(gradient[k], far));
-    }
-    lower = lo;
-    upper = hi;
+  void evaluate(const __m128 center[3], const __m128 extent[3], __m128& middle,
+                __m128& radius) const {
+    middle = _mm_add_ps(
+        _mm_add_ps(offset, _mm_mul_ps(gradient[0], center[0])),
+        _mm_add_ps(_mm_mul_ps(gradient[1], center[1]), _mm_mul_ps(gradient[2], center[2])));
+    radius = _mm_add_ps(_mm_add_ps(error, _mm_mul_ps(gradient_magnitude[0], extent[0])),
+                        _mm_add_ps(_mm_mul_ps(gradient_magnitude[1], extent[1]),
+                                   _mm_mul_ps(gradient_magnitude[2], extent[2])));
   }
 };
 
@@ -155,20 +154,21 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     throw std::invalid_argument("LineQuery: max_leaf_size must be in [1, 32], got " +
                                 std::to_string(options_.max_leaf_size));
   // Occluder triangles, canonical vertex order, and their float boxes.
-  std::vector<Triangle> occluders;
+  std::vector<OccluderTriangle> occluders;
   std::vector<RTCBuildPrimitive> primitives;
   size_t input_count = indices.size() / 3;
   occluders.reserve(input_count);
   primitives.reserve(input_count);
   scene_max_abs_ = {0, 0, 0};
   for (size_t i = 0; i < input_count; ++i) {
-    Triangle triangle{{positions.at(indices[3 * i]), positions.at(indices[3 * i + 1]),
-                       positions.at(indices[3 * i + 2])}};
-    if (!is_occluder_triangle(triangle.v[0], triangle.v[1], triangle.v[2])) continue;
-    order_canonically(triangle.v[0], triangle.v[1], triangle.v[2]);
+    std::optional<OccluderTriangle> triangle =
+        OccluderTriangle::make(positions.at(indices[3 * i]), positions.at(indices[3 * i + 1]),
+                               positions.at(indices[3 * i + 2]));
+    if (!triangle) continue;
     RTCBuildPrimitive primitive;
-    Vec3 lower = triangle.v[0], upper = triangle.v[0];
-    for (const Vec3& v : triangle.v) {
+    Vec3 lower = triangle->vertex(0), upper = lower;
+    for (int vertex = 0; vertex < 3; ++vertex) {
+      Vec3 v = triangle->vertex(vertex);
       for (int k = 0; k < 3; ++k) {
         lower[k] = std::min(lower[k], v[k]);
         upper[k] = std::max(upper[k], v[k]);
@@ -184,7 +184,7 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     primitive.geomID = 0;
     primitive.primID = static_cast<unsigned>(occluders.size());
     primitives.push_back(primitive);
-    occluders.push_back(triangle);
+    occluders.push_back(*triangle);
   }
   nodes_.clear();
   triangles_.clear();
@@ -231,9 +231,12 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   const float nan = std::numeric_limits<float>::quiet_NaN();
   auto new_node = [&]() {
     Node node;
-    for (auto& side : node.bounds)
-      for (auto& axis : side)
-        for (float& value : axis) value = nan;
+    for (int k = 0; k < 3; ++k) {
+      for (int slot = 0; slot < 4; ++slot) {
+        node.center[k][slot] = nan;
+        node.extent[k][slot] = 0;
+      }
+    }
     for (uint32_t& code : node.child) code = 0;
     nodes_.push_back(node);
     return static_cast<uint32_t>(nodes_.size() - 1);
@@ -246,12 +249,14 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   };
   auto set_slot = [&](uint32_t index, int slot, const RTCBounds& bounds, uint32_t code) {
     Node& node = nodes_[index];
-    node.bounds[0][0][slot] = bounds.lower_x;
-    node.bounds[0][1][slot] = bounds.lower_y;
-    node.bounds[0][2][slot] = bounds.lower_z;
-    node.bounds[1][0][slot] = bounds.upper_x;
-    node.bounds[1][1][slot] = bounds.upper_y;
-    node.bounds[1][2][slot] = bounds.upper_z;
+    const double lower[3] = {bounds.lower_x, bounds.lower_y, bounds.lower_z};
+    const double upper[3] = {bounds.upper_x, bounds.upper_y, bounds.upper_z};
+    for (int k = 0; k < 3; ++k) {
+      // Round the centre, then grow the extent until the box holds [lower, upper].
+      float center = static_cast<float>(0.5 * (lower[k] + upper[k]));
+      node.center[k][slot] = center;
+      node.extent[k][slot] = round_up(std::max(center - lower[k], upper[k] - center));
+    }
     node.child[slot] = code;
   };
   // Returns the code of the flattened subtree.
@@ -303,12 +308,13 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
 
   // The shadow triangle's planes as linear functions over boxes (see shadow_triangle.h):
   // distance to the plane, alpha, beta and depth s = alpha + beta.
-  const BoxRange4 distance_range(shadow->plane_normal, x, scene_max_abs_);
-  const BoxRange4 alpha_range(shadow->alpha_gradient, x, scene_max_abs_);
-  const BoxRange4 beta_range(shadow->beta_gradient, x, scene_max_abs_);
-  const BoxRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);
+  const LinearRange4 distance_range(shadow->plane_normal, x, scene_max_abs_);
+  const LinearRange4 alpha_range(shadow->alpha_gradient, x, scene_max_abs_);
+  const LinearRange4 beta_range(shadow->beta_gradient, x, scene_max_abs_);
+  const LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);
   const __m128 zero = _mm_setzero_ps();
   const __m128 tiny = _mm_set1_ps(FLT_MIN);
+  const __m128 sign_bit = _mm_set1_ps(-0.0f);
   const __m128 s_min = _mm_set1_ps(static_cast<float>(shadow->s_min));
   const __m128 s_max = _mm_set1_ps(static_cast<float>(shadow->s_max));
 
@@ -327,10 +333,8 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
       uint32_t first = (entry.code & ~kLeafFlag) >> kCountBits;
       uint32_t count = (entry.code & ((1u << kCountBits) - 1)) + 1;
       for (uint32_t i = first; i < first + count; ++i) {
-        const Triangle& triangle = triangles_[i];
         ++triangles_tested;
-        std::optional<Interval> cut =
-            occluder_cut(*shadow, triangle.v[0], triangle.v[1], triangle.v[2]);
+        std::optional<Interval> cut = occluder_cut(*shadow, triangles_[i]);
         if (!cut) continue;
         ++cuts;
         out.subtract(cut->lo, cut->hi);
@@ -344,17 +348,26 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
 
     const Node& node = nodes_[entry.code];
     ++nodes_visited;
-    __m128 distance_lower, distance_upper, alpha_lower, alpha_upper, beta_lower, beta_upper,
-        depth_lower, depth_upper;
-    distance_range.evaluate(node, distance_lower, distance_upper);
-    alpha_range.evaluate(node, alpha_lower, alpha_upper);
-    beta_range.evaluate(node, beta_lower, beta_upper);
-    depth_range.evaluate(node, depth_lower, depth_upper);
-    // Box against the shadow plane, the side planes through x (alpha >= 0, beta >= 0), the
-    // plane through the segment (s <= s_max) and the self-occlusion plane (s >= s_min).
-    // Ordered comparisons: NaN boxes (empty slots) fail.
-    __m128 keep =
-        _mm_and_ps(_mm_cmple_ps(distance_lower, zero), _mm_cmpge_ps(distance_upper, zero));
+    const __m128 center[3] = {_mm_load_ps(node.center[0]), _mm_load_ps(node.center[1]),
+                              _mm_load_ps(node.center[2])};
+    const __m128 extent[3] = {_mm_load_ps(node.extent[0]), _mm_load_ps(node.extent[1]),
+                              _mm_load_ps(node.extent[2])};
+    __m128 distance_middle, distance_radius, alpha_middle, alpha_radius, beta_middle, beta_radius,
+        depth_middle, depth_radius;
+    distance_range.evaluate(center, extent, distance_middle, distance_radius);
+    alpha_range.evaluate(center, extent, alpha_middle, alpha_radius);
+    beta_range.evaluate(center, extent, beta_middle, beta_radius);
+    depth_range.evaluate(center, extent, depth_middle, depth_radius);
+    __m128 alpha_lower = _mm_sub_ps(alpha_middle, alpha_radius);
+    __m128 alpha_upper = _mm_add_ps(alpha_middle, alpha_radius);
+    __m128 beta_lower = _mm_sub_ps(beta_middle, beta_radius);
+    __m128 beta_upper = _mm_add_ps(beta_middle, beta_radius);
+    __m128 depth_lower = _mm_sub_ps(depth_middle, depth_radius);
+    __m128 depth_upper = _mm_add_ps(depth_middle, depth_radius);
+    // Box against the shadow plane (|distance| <= radius), the side planes through x
+    // (alpha >= 0, beta >= 0), the plane through the segment (s <= s_max) and the
+    // self-occlusion plane (s >= s_min). Ordered comparisons: NaN centres (empty slots) fail.
+    __m128 keep = _mm_cmple_ps(_mm_andnot_ps(sign_bit, distance_middle), distance_radius);
     keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
     keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
     keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, s_min));
@@ -377,13 +390,12 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     _mm_store_ps(t_uppers, t_upper);
     _mm_store_ps(depth_lowers, depth_lower);
 
-    // Surviving children whose projection is not yet occluded, nearest to x first.
+    // Surviving children, nearest to x first. (Whether their projection is already occluded
+    // is checked when they are popped.)
     int order[4];
     int kept = 0;
     for (int slot = 0; slot < 4; ++slot) {
       if (!(mask & (1 << slot))) continue;
-      if (!out.overlaps(t_lowers[slot] - kProjectionSlack, t_uppers[slot] + kProjectionSlack))
-        continue;
       int position = kept++;
       while (position > 0 && depth_lowers[order[position - 1]] > depth_lowers[slot]) {
         order[position] = order[position - 1];
@@ -394,7 +406,19 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     // Push far to near so the nearest is popped first.
     for (int i = kept - 1; i >= 0; --i) {
       int slot = order[i];
-      stack[top++] = {node.child[slot], t_lowers[slot], t_uppers[slot]};
+      uint32_t code = node.child[slot];
+      stack[top++] = {code, t_lowers[slot], t_uppers[slot]};
+      // Start loading it now: the walk is bound by memory on large scenes.
+      if (code & kLeafFlag) {
+        const char* leaf =
+            reinterpret_cast<const char*>(&triangles_[(code & ~kLeafFlag) >> kCountBits]);
+        _mm_prefetch(leaf, _MM_HINT_T0);
+        _mm_prefetch(leaf + 64, _MM_HINT_T0);
+      } else {
+        const char* child = reinterpret_cast<const char*>(&nodes_[code]);
+        _mm_prefetch(child, _MM_HINT_T0);
+        _mm_prefetch(child + 64, _MM_HINT_T0);
+      }
     }
   }
   if (stats) {
@@ -420,18 +444,20 @@ bool LineQuery::occluded(const Vec3& x, const Vec3& p) const {
       uint32_t first = (code & ~kLeafFlag) >> kCountBits;
       uint32_t count = (code & ((1u << kCountBits) - 1)) + 1;
       for (uint32_t i = first; i < first + count; ++i) {
-        const Triangle& t = triangles_[i];
-        if (segment_hits_triangle(x, p, s_min, s_max, t.v[0], t.v[1], t.v[2])) return true;
+        const OccluderTriangle& t = triangles_[i];
+        if (segment_hits_triangle(x, p, s_min, s_max, t.vertex(0), t.vertex(1), t.vertex(2)))
+          return true;
       }
       continue;
     }
     const Node& node = nodes_[code];
     for (int slot = 0; slot < 4; ++slot) {
-      if (std::isnan(node.bounds[0][0][slot])) continue;
+      if (std::isnan(node.center[0][slot])) continue;
       // Slab test of the parameter range [0, 1] of x + s (p - x).
       double enter = 0, exit = 1;
       for (int k = 0; k < 3 && enter <= exit; ++k) {
-        double lower = node.bounds[0][k][slot] - pad, upper = node.bounds[1][k][slot] + pad;
+        double center = node.center[k][slot], extent = node.extent[k][slot];
+        double lower = center - extent - pad, upper = center + extent + pad;
         if (direction[k] == 0) {
           if (x[k] < lower || x[k] > upper) exit = -1;
           continue;

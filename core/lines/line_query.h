@@ -5,7 +5,8 @@
 //
 // - a 4-wide BVH (BVH4) built by Embree's rtcBuildBVH (SAH, MEDIUM quality by default) through
 //   our own node callbacks, then flattened into one array of nodes with float boxes stored
-//   structure-of-arrays, and leaf triangles stored inline in double, vertices in canonical order;
+//   structure-of-arrays, and leaf triangles stored contiguously in leaf order (float vertices
+//   in canonical order, OccluderTriangle);
 // - our own traversal: the four child boxes of a node are tested together (SSE) against the
 //   shadow triangle's plane, its three side planes and the self-occlusion plane near x, with a
 //   conservative float error bound; each surviving child's box is projected from x onto the
@@ -69,15 +70,13 @@ class LineQuery {
   size_t node_count() const { return nodes_.size(); }
   const LineQueryOptions& options() const { return options_; }
 
-  // One BVH4 node: the boxes of its four children, structure-of-arrays so one SSE register
-  // holds one coordinate of all four. Empty slots have NaN boxes (every test rejects them).
+  // One BVH4 node: the boxes of its four children as centre and half extent (each box
+  // contains the children's float boxes), structure-of-arrays so one SSE register holds one
+  // coordinate of all four. Empty slots have a NaN centre (every test rejects them).
   struct alignas(64) Node {
-    float bounds[2][3][4];  // [lower/upper][axis][child]
-    uint32_t child[4];      // inner node index, or kLeafFlag | first << kCountBits | count - 1
-  };
-  // A leaf triangle: vertices in canonical order (order_canonically).
-  struct Triangle {
-    Vec3 v[3];
+    float center[3][4];  // [axis][child]
+    float extent[3][4];  // [axis][child], >= 0
+    uint32_t child[4];   // inner node index, or kLeafFlag | first << kCountBits | count - 1
   };
   static constexpr uint32_t kLeafFlag = 0x80000000u;
   static constexpr uint32_t kCountBits = 5;  // up to 32 triangles per leaf
@@ -86,8 +85,8 @@ class LineQuery {
   void build(const std::vector<Vec3>& positions, const std::vector<uint32_t>& indices);
 
   LineQueryOptions options_;
-  std::vector<Node> nodes_;  // nodes_[0] is the root
-  std::vector<Triangle> triangles_;
+  std::vector<Node> nodes_;                  // nodes_[0] is the root
+  std::vector<OccluderTriangle> triangles_;  // in leaf order
   Vec3 scene_max_abs_;  // per axis, the largest |coordinate| (float error bounds)
 };
 

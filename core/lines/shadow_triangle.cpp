@@ -7,28 +7,37 @@ namespace penumbra {
 std::optional<ShadowTriangle> ShadowTriangle::make(const Vec3& x, const Vec3& a, const Vec3& b,
                                                    const ShadowTriangleTolerances& tolerances) {
   if (!is_finite(x) || !is_finite(a) || !is_finite(b)) return std::nullopt;
-  Vec3 to_a = a - x, to_b = b - x;
-  Vec3 normal = cross_accurate(to_a, to_b);
+  Vec3 to_a = a - x, to_b = b - x, segment = b - a;
+  // cross(to_a, to_b) == cross(to_a, segment); the latter does not cancel when x is far away
+  // (to_a and to_b nearly parallel).
+  Vec3 normal = cross(to_a, segment);
   double normal_length_squared = length_squared(normal);
   // Degenerate when the angle at x is below ~1e-10 rad (a == b, x on the segment's line) or
   // when the squared lengths leave the double range.
   double scale = length_squared(to_a) * length_squared(to_b);
   if (!(normal_length_squared > 1e-20 * scale) || !std::isfinite(scale)) return std::nullopt;
 
-  ShadowTriangle shadow;
+  std::optional<ShadowTriangle> result(std::in_place);  // filled in place (no copy)
+  ShadowTriangle& shadow = *result;
   shadow.x = x;
+  shadow.a = a;
+  shadow.b = b;
   // alpha(a) = 1, alpha(b) = 0 and beta(a) = 0, beta(b) = 1, both 0 along the plane normal.
-  shadow.alpha_gradient = cross(to_b, normal) / normal_length_squared;
-  shadow.beta_gradient = cross(normal, to_a) / normal_length_squared;
+  double inverse = 1 / normal_length_squared;
+  shadow.alpha_gradient = cross(to_b, normal) * inverse;
+  shadow.beta_gradient = cross(normal, to_a) * inverse;
   // Unnormalized: for small integer coordinates the signed distances are then exact, so
   // vertices exactly on the plane are recognised as such.
   shadow.plane_normal = normal;
   shadow.s_min = tolerances.self_occlusion_epsilon;
   shadow.s_max = 1 - tolerances.light_plane_epsilon;
   // The free zone's size near x: s_min times the distance from x to the segment's line.
-  shadow.self_occlusion_distance = shadow.s_min * std::sqrt(normal_length_squared) / length(b - a);
+  shadow.self_occlusion_distance =
+      shadow.s_min * std::sqrt(normal_length_squared / length_squared(segment));
+  shadow.self_occlusion_distance_squared =
+      shadow.self_occlusion_distance * shadow.self_occlusion_distance;
   if (!is_finite(shadow.alpha_gradient) || !is_finite(shadow.beta_gradient)) return std::nullopt;
-  return shadow;
+  return result;
 }
 
 bool is_occluder_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
@@ -37,10 +46,38 @@ bool is_occluder_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
   return area_vector.x != 0 || area_vector.y != 0 || area_vector.z != 0;
 }
 
-std::optional<Interval> occluder_cut(const ShadowTriangle& shadow, const Vec3& v0, const Vec3& v1,
-                                     const Vec3& v2) {
+std::optional<OccluderTriangle> OccluderTriangle::make(const Vec3& v0, const Vec3& v1,
+                                                       const Vec3& v2) {
+  auto round_to_float = [](const Vec3& p) {
+    return Vec3(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+  };
+  Vec3 vertices[3] = {round_to_float(v0), round_to_float(v1), round_to_float(v2)};
+  if (!is_occluder_triangle(vertices[0], vertices[1], vertices[2])) return std::nullopt;
+  order_canonically(vertices[0], vertices[1], vertices[2]);
+  OccluderTriangle occluder;
+  for (int k = 0; k < 3; ++k)
+    for (int axis = 0; axis < 3; ++axis)
+      occluder.v[k][axis] = static_cast<float>(vertices[k][axis]);
+  return occluder;
+}
+
+std::optional<Interval> occluder_cut(const ShadowTriangle& shadow,
+                                     const OccluderTriangle& occluder) {
+  const Vec3 v[3] = {occluder.vertex(0), occluder.vertex(1), occluder.vertex(2)};
+  // The shadow triangle against the occluder's plane (Möller 1997's other rejection): x on
+  // the plane means edge-on; x, a, b strictly on one side means no crossing. First, since
+  // the node tests have already kept mostly triangles near the shadow plane.
+  Vec3 occluder_normal = cross(v[1] - v[0], v[2] - v[0]);
+  double x_side = dot(occluder_normal, shadow.x - v[0]);
+  if (x_side * x_side <= shadow.self_occlusion_distance_squared * length_squared(occluder_normal))
+    return std::nullopt;
+  double a_side = dot(occluder_normal, shadow.a - v[0]);
+  double b_side = dot(occluder_normal, shadow.b - v[0]);
+  if (x_side > 0 && a_side > 0 && b_side > 0) return std::nullopt;
+  if (x_side < 0 && a_side < 0 && b_side < 0) return std::nullopt;
+
   // Signed distances of the vertices to the shadow plane.
-  Vec3 q[3] = {v0 - shadow.x, v1 - shadow.x, v2 - shadow.x};
+  Vec3 q[3] = {v[0] - shadow.x, v[1] - shadow.x, v[2] - shadow.x};
   double distance[3];
   for (int k = 0; k < 3; ++k) distance[k] = dot(q[k], shadow.plane_normal);
   // Entirely on one side: no crossing. In the plane: coplanar, does not occlude.
@@ -108,15 +145,6 @@ std::optional<Interval> occluder_cut(const ShadowTriangle& shadow, const Vec3& v
   double hi = std::min(std::max(t0, t1), 1.0);
   if (!(lo < hi)) return std::nullopt;
 
-  // An occluder whose plane passes through x (within the free zone's size) is seen edge-on:
-  // it occludes nothing, while rounding would give it a cut of a few ulps. This is the surface
-  // x lies on and its coplanar neighbours: without this, the part of the segment below that
-  // surface's horizon would get a sliver cut (a false visibility boundary). Checked only for
-  // triangles that cut, so it costs nothing on the common path.
-  Vec3 occluder_normal = cross(v1 - v0, v2 - v0);
-  double plane_distance = std::fabs(dot(shadow.x - v0, occluder_normal));
-  if (plane_distance <= shadow.self_occlusion_distance * length(occluder_normal))
-    return std::nullopt;
   return Interval{lo, hi};
 }
 
@@ -154,12 +182,12 @@ void visible_intervals_brute_force(const std::vector<Vec3>& positions,
     // Degenerate shadow triangle: one shadow ray to the segment's midpoint.
     Vec3 midpoint = 0.5 * (a + b);
     for (size_t i = 0; i < triangle_count; ++i) {
-      const Vec3& v0 = positions[indices[3 * i]];
-      const Vec3& v1 = positions[indices[3 * i + 1]];
-      const Vec3& v2 = positions[indices[3 * i + 2]];
-      if (!is_occluder_triangle(v0, v1, v2)) continue;
+      std::optional<OccluderTriangle> occluder = OccluderTriangle::make(
+          positions[indices[3 * i]], positions[indices[3 * i + 1]], positions[indices[3 * i + 2]]);
+      if (!occluder) continue;
       if (segment_hits_triangle(x, midpoint, tolerances.self_occlusion_epsilon,
-                                1 - tolerances.light_plane_epsilon, v0, v1, v2)) {
+                                1 - tolerances.light_plane_epsilon, occluder->vertex(0),
+                                occluder->vertex(1), occluder->vertex(2))) {
         out.clear();
         return;
       }
@@ -167,12 +195,10 @@ void visible_intervals_brute_force(const std::vector<Vec3>& positions,
     return;
   }
   for (size_t i = 0; i < triangle_count; ++i) {
-    Vec3 v0 = positions[indices[3 * i]];
-    Vec3 v1 = positions[indices[3 * i + 1]];
-    Vec3 v2 = positions[indices[3 * i + 2]];
-    if (!is_occluder_triangle(v0, v1, v2)) continue;
-    order_canonically(v0, v1, v2);
-    if (std::optional<Interval> cut = occluder_cut(*shadow, v0, v1, v2)) {
+    std::optional<OccluderTriangle> occluder = OccluderTriangle::make(
+        positions[indices[3 * i]], positions[indices[3 * i + 1]], positions[indices[3 * i + 2]]);
+    if (!occluder) continue;
+    if (std::optional<Interval> cut = occluder_cut(*shadow, *occluder)) {
       out.subtract(cut->lo, cut->hi);
       if (out.fully_occluded()) return;
     }

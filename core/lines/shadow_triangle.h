@@ -41,13 +41,14 @@ struct ShadowTriangleTolerances {
 };
 
 struct ShadowTriangle {
-  Vec3 x;
+  Vec3 x, a, b;
   Vec3 alpha_gradient, beta_gradient, plane_normal;  // see the file comment
   double s_min = 0, s_max = 1;
   // s_min as a distance: s_min times the distance from x to the segment's line. An occluder
   // whose plane passes this close to x is seen edge-on (the surface x lies on, or coplanar with
   // it) and does not occlude.
   double self_occlusion_distance = 0;
+  double self_occlusion_distance_squared = 0;
 
   // The shadow triangle of x and segment a->b, or empty when it is degenerate (a == b, x on the
   // segment's line or too close to it for the plane to be defined, non-finite input).
@@ -74,15 +75,28 @@ inline void order_canonically(Vec3& v0, Vec3& v1, Vec3& v2) {
 // dropped before any query (they occlude a set of measure zero).
 bool is_occluder_triangle(const Vec3& v0, const Vec3& v1, const Vec3& v2);
 
+// An occluder triangle prepared for queries: vertices rounded to float, as Embree sees them
+// (36 bytes instead of 72: large scenes are bound by memory traffic), in canonical order.
+// Everything computed from them is double precision; the rounding is per vertex, so shared
+// vertices stay shared and closed meshes stay closed.
+struct OccluderTriangle {
+  float v[3][3];
+
+  Vec3 vertex(int k) const { return {v[k][0], v[k][1], v[k][2]}; }
+  // Empty for triangles that cannot occlude: non-finite or zero area after rounding.
+  static std::optional<OccluderTriangle> make(const Vec3& v0, const Vec3& v1, const Vec3& v2);
+};
+
 // The closed interval of t an occluder triangle removes from the segment, or empty when it
-// does not cross the shadow triangle strictly between x and the segment. The vertices must be
-// in canonical order (order_canonically). Coplanar occluders (lying in the shadow plane) do not
-// occlude: the set of such configurations has measure zero, and in a closed mesh their
-// neighbours still cut along the shared edges. Occluders whose plane passes through x (within
-// ShadowTriangle::self_occlusion_distance) are seen edge-on and do not occlude either.
-// Zero-length cuts are reported empty.
-std::optional<Interval> occluder_cut(const ShadowTriangle& shadow, const Vec3& v0, const Vec3& v1,
-                                     const Vec3& v2);
+// does not cross the shadow triangle strictly between x and the segment.
+// - Occluders whose plane passes through x (within ShadowTriangle::self_occlusion_distance)
+//   are seen edge-on and do not occlude: the surface x lies on and its coplanar neighbours
+//   (rounding would otherwise give them sliver cuts, false visibility boundaries).
+// - Coplanar occluders (lying in the shadow plane) do not occlude: such configurations have
+//   measure zero, and in a closed mesh their neighbours still cut along the shared edges.
+// - Zero-length cuts are reported empty.
+std::optional<Interval> occluder_cut(const ShadowTriangle& shadow,
+                                     const OccluderTriangle& occluder);
 
 // True when the triangle blocks the segment x->p strictly inside its parameter range
 // (s_min, s_max) along x + s (p - x). Double-precision Möller-Trumbore; used for degenerate

@@ -51,15 +51,16 @@ void expect_same_intervals(const IntervalList& actual, const IntervalList& expec
   }
 }
 
+// Shadow ray against every triangle, rounded to float like the line query's occluders.
 bool ray_blocked_brute_force(const TriangleMesh& mesh, const Vec3& x, const Vec3& p,
                              const ShadowTriangleTolerances& tolerances = {}) {
   for (size_t i = 0; i < mesh.triangle_count(); ++i) {
-    const Vec3& v0 = mesh.positions[mesh.indices[3 * i]];
-    const Vec3& v1 = mesh.positions[mesh.indices[3 * i + 1]];
-    const Vec3& v2 = mesh.positions[mesh.indices[3 * i + 2]];
-    if (is_occluder_triangle(v0, v1, v2) &&
-        segment_hits_triangle(x, p, tolerances.self_occlusion_epsilon,
-                              1 - tolerances.light_plane_epsilon, v0, v1, v2))
+    std::optional<OccluderTriangle> occluder = OccluderTriangle::make(
+        mesh.positions[mesh.indices[3 * i]], mesh.positions[mesh.indices[3 * i + 1]],
+        mesh.positions[mesh.indices[3 * i + 2]]);
+    if (occluder && segment_hits_triangle(x, p, tolerances.self_occlusion_epsilon,
+                                          1 - tolerances.light_plane_epsilon, occluder->vertex(0),
+                                          occluder->vertex(1), occluder->vertex(2)))
       return true;
   }
   return false;
@@ -115,17 +116,18 @@ TriangleMesh floor_grid(double half, double height, int n) {
 }
 
 TEST(LineQuery, StripOccluderMatchesClosedForm) {
-  // x at the origin, segment from (-1,2,0) to (1,2,0); a strip at y = 1 over x in [0.1, 0.3]
-  // projects from x (scale 2) onto x in [0.2, 0.6] of the segment: t in [0.6, 0.8].
-  TriangleMesh mesh = quad({0.1, 1, -1}, {0.2, 0, 0}, {0, 0, 2});
+  // x at the origin, segment from (-1,2,0) to (1,2,0); a strip at y = 1 over x in
+  // [0.125, 0.375] projects from x (scale 2) onto x in [0.25, 0.75] of the segment: t in
+  // [0.625, 0.875]. (Coordinates exact in float: occluders are rounded to float.)
+  TriangleMesh mesh = quad({0.125, 1, -1}, {0.25, 0, 0}, {0, 0, 2});
   LineQuery line_query(mesh.positions, mesh.indices);
   IntervalList visible = query(line_query, {0, 0, 0}, {-1, 2, 0}, {1, 2, 0});
   ASSERT_EQ(visible.size(), 2u);
   EXPECT_NEAR(visible[0].lo, 0.0, 1e-15);
-  EXPECT_NEAR(visible[0].hi, 0.6, 1e-15);
-  EXPECT_NEAR(visible[1].lo, 0.8, 1e-15);
+  EXPECT_NEAR(visible[0].hi, 0.625, 1e-15);
+  EXPECT_NEAR(visible[1].lo, 0.875, 1e-15);
   EXPECT_NEAR(visible[1].hi, 1.0, 1e-15);
-  EXPECT_NEAR(visible.visible_length(), 0.8, 1e-15);
+  EXPECT_NEAR(visible.visible_length(), 0.75, 1e-15);
 }
 
 TEST(LineQuery, BruteForceAgreesWithShadowRays) {

@@ -1,0 +1,362 @@
+// Line query throughput against Embree shadow rays, on the same shading points and light.
+//
+// Scenes (PERFORMANCE.md): S1 cornell-occluders (scenes/cornell-occluders.json, or a Cornell
+// box with 20 floating boxes built here when the file is missing or does not load); S3 = S1 plus
+// a ~1M-triangle UV sphere; S2 = S1 plus 1M small random triangles. Shading points are the first
+// hits of camera rays (Embree rtcIntersect1) that face the light; per shading point 16 random
+// light samples: a point on the quad light for the shadow ray (rtcOccluded1, tnear/tfar set to
+// the line query's own tolerances) and a line along edge1 at a random offset for the line query.
+//
+// Each benchmark reports CPU time per query on one thread; the summary printed at the end gives
+// the ratio line query / shadow ray per scene, measured in the same run (figures on these shared
+// machines drift by ~25% hour to hour; ratios in one run do not).
+//
+// Run: build-*/bench/line_query_bench [--benchmark_filter=S1] [--benchmark_repetitions=5]
+
+#include <benchmark/benchmark.h>
+#include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/lines/line_query.h"
+#include "core/lines/occluder_meshes.h"
+#include "core/scene/scene.h"
+
+namespace penumbra {
+namespace {
+
+struct QuadLight {
+  Vec3 origin, edge1, edge2;
+};
+
+struct BenchScene {
+  std::string name;
+  std::string description;
+  TriangleMesh mesh;
+  QuadLight light;
+  Camera camera;
+};
+
+// S1. The bundled scene when it loads, otherwise a Cornell box of the same size with 20
+// floating boxes.
+BenchScene cornell_occluders() {
+  BenchScene scene;
+  scene.name = "S1";
+  std::string path = std::string(PENUMBRA_SOURCE_DIR) + "/scenes/cornell-occluders.json";
+  try {
+    Scene loaded = load_scene(path);
+    if (!loaded.lights.empty() && loaded.lights[0].type == LightType::Quad) {
+      scene.mesh.positions = loaded.positions;
+      scene.mesh.indices = loaded.indices;
+      scene.light = {loaded.lights[0].origin, loaded.lights[0].edge1, loaded.lights[0].edge2};
+      scene.camera = loaded.camera;
+      scene.description = "scenes/cornell-occluders.json";
+      return scene;
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "line_query_bench: %s does not load (%s); building S1 in code\n",
+                 path.c_str(), error.what());
+  }
+  scene.description = "cornell box with 20 floating boxes, built in code";
+  // Room [-1,1] x [0,2] x [-1,1], open towards +z (the camera).
+  auto add_quad = [&](const Vec3& origin, const Vec3& u, const Vec3& v) {
+    uint32_t base = static_cast<uint32_t>(scene.mesh.positions.size());
+    scene.mesh.positions.insert(scene.mesh.positions.end(),
+                                {origin, origin + u, origin + u + v, origin + v});
+    scene.mesh.add_triangle(base, base + 1, base + 2);
+    scene.mesh.add_triangle(base, base + 2, base + 3);
+  };
+  add_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2});   // floor
+  add_quad({-1, 2, -1}, {2, 0, 0}, {0, 0, 2});   // ceiling
+  add_quad({-1, 0, -1}, {2, 0, 0}, {0, 2, 0});   // back
+  add_quad({-1, 0, -1}, {0, 0, 2}, {0, 2, 0});   // left
+  add_quad({1, 0, -1}, {0, 0, 2}, {0, 2, 0});    // right
+  std::mt19937_64 rng(20);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int i = 0; i < 20; ++i) {
+    Vec3 center(-0.7 + 1.4 * unit(rng), 0.9 + 0.6 * unit(rng), -0.6 + 1.2 * unit(rng));
+    Vec3 half(0.05 + 0.1 * unit(rng), 0.02 + 0.02 * unit(rng), 0.05 + 0.1 * unit(rng));
+    scene.mesh.append(box_mesh(center - half, center + half));
+  }
+  scene.light = {{-0.24, 1.98, -0.22}, {0.47, 0, 0}, {0, 0, 0.38}};
+  scene.camera.position = {0, 1, 6.8};
+  scene.camera.look_at = {0, 1, 0};
+  scene.camera.fov_y_deg = 19.5;
+  scene.camera.width = scene.camera.height = 512;
+  return scene;
+}
+
+BenchScene with_sphere() {
+  BenchScene scene = cornell_occluders();
+  scene.name = "S3";
+  scene.description = "S1 + UV sphere of ~1M triangles";
+  scene.mesh.append(uv_sphere_mesh({0.05, 0.55, -0.1}, 0.35, 500, 1000));
+  return scene;
+}
+
+BenchScene with_random_triangles() {
+  BenchScene scene = cornell_occluders();
+  scene.name = "S2";
+  scene.description = "S1 + 1M random triangles (size 0.006) in [-1,1]x[0.1,1.9]x[-1,1]";
+  scene.mesh.append(random_triangles_mesh(1'000'000, {-1, 0.1, -1}, {1, 1.9, 1}, 0.006, 99));
+  return scene;
+}
+
+BenchScene make_scene(const std::string& name) {
+  if (name == "S3") return with_sphere();
+  if (name == "S2") return with_random_triangles();
+  return cornell_occluders();
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A scene ready to query: the Embree scene for rays, both line-query builds, and the queries.
+struct Prepared {
+  BenchScene scene;
+  RTCDevice device = nullptr;
+  RTCScene rtc_scene = nullptr;
+  std::map<LineQueryBuildQuality, std::unique_ptr<LineQuery>> line_queries;
+  std::map<LineQueryBuildQuality, double> build_seconds;
+  double embree_build_seconds = 0;
+  struct Query {
+    Vec3 x;
+    Vec3 light_point;   // shadow ray target
+    Vec3 line_a, line_b;  // line sample
+  };
+  std::vector<Query> queries;
+
+  explicit Prepared(const std::string& name) : scene(make_scene(name)) {
+    device = rtcNewDevice(nullptr);
+    auto start = std::chrono::steady_clock::now();
+    rtc_scene = rtcNewScene(device);
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+        scene.mesh.positions.size()));
+    for (size_t i = 0; i < scene.mesh.positions.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        vertices[3 * i + k] = static_cast<float>(scene.mesh.positions[i][k]);
+    auto* triangles = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(uint32_t), scene.mesh.triangle_count()));
+    std::copy(scene.mesh.indices.begin(), scene.mesh.indices.end(), triangles);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(rtc_scene, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcSetSceneBuildQuality(rtc_scene, RTC_BUILD_QUALITY_MEDIUM);
+    rtcCommitScene(rtc_scene);
+    embree_build_seconds = seconds_since(start);
+    make_queries();
+  }
+  ~Prepared() {
+    rtcReleaseScene(rtc_scene);
+    rtcReleaseDevice(device);
+  }
+
+  const LineQuery& line_query(LineQueryBuildQuality quality) {
+    auto& slot = line_queries[quality];
+    if (!slot) {
+      LineQueryOptions options;
+      options.build_quality = quality;
+      auto start = std::chrono::steady_clock::now();
+      slot = std::make_unique<LineQuery>(scene.mesh.positions, scene.mesh.indices, options);
+      build_seconds[quality] = seconds_since(start);
+    }
+    return *slot;
+  }
+
+  void make_queries() {
+    const Camera& camera = scene.camera;
+    Vec3 forward = normalize(camera.look_at - camera.position);
+    Vec3 right = normalize(cross(forward, camera.up));
+    Vec3 up = cross(right, forward);
+    double tan_half = std::tan(0.5 * camera.fov_y_deg * kPi / 180);
+    double aspect = static_cast<double>(camera.width) / camera.height;
+    std::mt19937_64 rng(1234);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const QuadLight& light = scene.light;
+    Vec3 light_center = light.origin + 0.5 * light.edge1 + 0.5 * light.edge2;
+    const int shading_points = 4096, samples_per_point = 16;
+    int attempts = 0;
+    while (queries.size() < static_cast<size_t>(shading_points * samples_per_point) &&
+           attempts++ < 100 * shading_points) {
+      // A camera ray through a random pixel.
+      double px = (2 * unit(rng) - 1) * tan_half * aspect, py = (1 - 2 * unit(rng)) * tan_half;
+      Vec3 direction = normalize(forward + px * right + py * up);
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      RTCRayHit hit{};
+      hit.ray.org_x = static_cast<float>(camera.position.x);
+      hit.ray.org_y = static_cast<float>(camera.position.y);
+      hit.ray.org_z = static_cast<float>(camera.position.z);
+      hit.ray.dir_x = static_cast<float>(direction.x);
+      hit.ray.dir_y = static_cast<float>(direction.y);
+      hit.ray.dir_z = static_cast<float>(direction.z);
+      hit.ray.tnear = 0;
+      hit.ray.tfar = 1e30f;
+      hit.ray.mask = ~0u;
+      hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(rtc_scene, &context, &hit);
+      if (hit.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      Vec3 normal = normalize(Vec3(hit.hit.Ng_x, hit.hit.Ng_y, hit.hit.Ng_z));
+      if (dot(normal, direction) > 0) normal = -normal;
+      Vec3 x = camera.position + static_cast<double>(hit.ray.tfar) * direction + 1e-4 * normal;
+      if (dot(normal, light_center - x) <= 0) continue;  // light below the horizon
+      for (int s = 0; s < samples_per_point; ++s) {
+        Query query;
+        query.x = x;
+        query.light_point = light.origin + unit(rng) * light.edge1 + unit(rng) * light.edge2;
+        query.line_a = light.origin + unit(rng) * light.edge2;
+        query.line_b = query.line_a + light.edge1;
+        queries.push_back(query);
+      }
+    }
+  }
+};
+
+std::unique_ptr<Prepared> current;
+Prepared& prepare(const std::string& name) {
+  if (!current || current->scene.name != name) {
+    current.reset();  // one large scene in memory at a time
+    current = std::make_unique<Prepared>(name);
+  }
+  return *current;
+}
+
+void shadow_rays(benchmark::State& state, const std::string& name) {
+  Prepared& prepared = prepare(name);
+  const ShadowTriangleTolerances tolerances;
+  size_t i = 0, occluded = 0, count = 0;
+  for (auto _ : state) {
+    const Prepared::Query& query = prepared.queries[i];
+    if (++i == prepared.queries.size()) i = 0;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray{};
+    ray.org_x = static_cast<float>(query.x.x);
+    ray.org_y = static_cast<float>(query.x.y);
+    ray.org_z = static_cast<float>(query.x.z);
+    Vec3 direction = query.light_point - query.x;  // unnormalized: t in [0,1] spans x -> light
+    ray.dir_x = static_cast<float>(direction.x);
+    ray.dir_y = static_cast<float>(direction.y);
+    ray.dir_z = static_cast<float>(direction.z);
+    ray.tnear = static_cast<float>(tolerances.self_occlusion_epsilon);
+    ray.tfar = static_cast<float>(1 - tolerances.light_plane_epsilon);
+    ray.mask = ~0u;
+    rtcOccluded1(prepared.rtc_scene, &context, &ray);
+    occluded += ray.tfar < 0;
+    ++count;
+  }
+  state.counters["occluded"] = static_cast<double>(occluded) / std::max<size_t>(count, 1);
+  state.counters["triangles"] = static_cast<double>(prepared.scene.mesh.triangle_count());
+  state.counters["build_ms"] = 1e3 * prepared.embree_build_seconds;
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(prepared.scene.description);
+}
+
+void line_queries(benchmark::State& state, const std::string& name,
+                  LineQueryBuildQuality quality) {
+  Prepared& prepared = prepare(name);
+  const LineQuery& line_query = prepared.line_query(quality);
+  IntervalList visible;
+  LineQueryStats stats;
+  size_t i = 0, fully_occluded = 0, count = 0, pieces = 0;
+  double visible_length = 0;
+  for (auto _ : state) {
+    const Prepared::Query& query = prepared.queries[i];
+    if (++i == prepared.queries.size()) i = 0;
+    line_query.visible_intervals(query.x, query.line_a, query.line_b, visible, &stats);
+    benchmark::DoNotOptimize(visible.size());
+    fully_occluded += visible.fully_occluded();
+    pieces += visible.size();
+    visible_length += visible.visible_length();
+    ++count;
+  }
+  double n = static_cast<double>(std::max<size_t>(count, 1));
+  state.counters["fully_occluded"] = fully_occluded / n;
+  state.counters["mean_visible"] = visible_length / n;
+  state.counters["pieces"] = pieces / n;
+  state.counters["nodes"] = stats.nodes_visited / n;
+  state.counters["tri_tests"] = stats.triangles_tested / n;
+  state.counters["cuts"] = stats.cuts / n;
+  state.counters["build_ms"] = 1e3 * prepared.build_seconds[quality];
+  state.SetItemsProcessed(state.iterations());
+}
+
+// Collects CPU time per query by benchmark name and prints the ratios at the end.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs) {
+      if (run.run_type == Run::RT_Aggregate && run.aggregate_name != "median") continue;
+      std::string name = run.run_name.function_name;
+      double ns = run.GetAdjustedCPUTime();  // time unit: ns (set below)
+      nanoseconds_[name] = ns;
+    }
+  }
+  void print_summary() const {
+    std::printf("\nPer query, one thread, CPU time (median when repeated):\n");
+    std::printf("%-6s %14s %18s %8s %18s %8s\n", "scene", "shadow ray ns", "line medium ns",
+                "ratio", "line high ns", "ratio");
+    for (const char* scene : {"S1", "S3", "S2"}) {
+      auto find = [&](const std::string& key) {
+        auto found = nanoseconds_.find(key);
+        return found == nanoseconds_.end() ? -1.0 : found->second;
+      };
+      double ray = find(std::string("shadow_ray/") + scene);
+      double medium = find(std::string("line_query_medium/") + scene);
+      double high = find(std::string("line_query_high/") + scene);
+      if (ray <= 0) continue;
+      std::printf("%-6s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene, ray, medium, medium / ray,
+                  high, high / ray);
+    }
+  }
+
+ private:
+  std::map<std::string, double> nanoseconds_;
+};
+
+}  // namespace
+}  // namespace penumbra
+
+int main(int argc, char** argv) {
+  using namespace penumbra;
+  // Flush-to-zero and denormals-are-zero, as every render thread sets them.
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+  for (const char* scene : {"S1", "S3", "S2"}) {
+    std::string name(scene);
+    benchmark::RegisterBenchmark((std::string("shadow_ray/") + name).c_str(),
+                                 [name](benchmark::State& state) { shadow_rays(state, name); })
+        ->Unit(benchmark::kNanosecond);
+    benchmark::RegisterBenchmark(
+        (std::string("line_query_medium/") + name).c_str(),
+        [name](benchmark::State& state) {
+          line_queries(state, name, LineQueryBuildQuality::Medium);
+        })
+        ->Unit(benchmark::kNanosecond);
+    benchmark::RegisterBenchmark(
+        (std::string("line_query_high/") + name).c_str(),
+        [name](benchmark::State& state) { line_queries(state, name, LineQueryBuildQuality::High); })
+        ->Unit(benchmark::kNanosecond);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.print_summary();
+  benchmark::Shutdown();
+  current.reset();
+  return 0;
+}
