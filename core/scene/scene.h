@@ -88,17 +88,22 @@ struct Scene {
   std::vector<uint32_t> triangle_materials;
   std::vector<Light> lights;
   std::map<std::string, Region> regions;
+  // Unknown optional keys the reader ignored (forward compatibility), each as "JSON path: note".
+  std::vector<std::string> warnings;
 
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
 // Limits past which a scene is refused as absurd (the error says which limit).
 struct SceneLimits {
-  int max_resolution = 16384;        // per image side
+  int max_resolution = 16384;  // per image side
   size_t max_triangles = 20'000'000;
   size_t max_lights = 4096;
   int max_sphere_subdivisions = 8;
-  double max_coordinate = 1e7;       // absolute value of any coordinate
+  double max_coordinate = 1e7;              // absolute value of any coordinate
+  size_t max_polygon_vertices = 1024;       // per polygon light
+  size_t max_file_bytes = size_t{1} << 30;  // the scene JSON and each OBJ file
+  int max_json_depth = 64;                  // nesting of JSON arrays and objects
 };
 
 // Parses a scene from JSON text. `base_dir` resolves OBJ paths (which may not leave it).

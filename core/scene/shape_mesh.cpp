@@ -1,0 +1,132 @@
+#include "core/scene/shape_mesh.h"
+
+#include <tiny_obj_loader.h>
+
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace penumbra {
+
+TriangleMesh quad_mesh(const Vec3& origin, const Vec3& edge1, const Vec3& edge2) {
+  TriangleMesh mesh;
+  mesh.positions = {origin, origin + edge1, origin + edge1 + edge2, origin + edge2};
+  mesh.indices = {0, 1, 2, 0, 2, 3};
+  return mesh;
+}
+
+TriangleMesh box_mesh(const Vec3& min, const Vec3& max) {
+  TriangleMesh mesh;
+  // Corner i has x = max.x when bit 0 is set, y = max.y for bit 1, z = max.z for bit 2.
+  for (int corner = 0; corner < 8; ++corner)
+    mesh.positions.push_back(
+        {(corner & 1) ? max.x : min.x, (corner & 2) ? max.y : min.y, (corner & 4) ? max.z : min.z});
+  // Each face as 4 corners counter-clockwise seen from outside: -x, +x, -y, +y, -z, +z.
+  constexpr std::array<std::array<uint32_t, 4>, 6> kFaces{{
+      {0, 4, 6, 2},
+      {1, 3, 7, 5},
+      {0, 1, 5, 4},
+      {2, 6, 7, 3},
+      {0, 2, 3, 1},
+      {4, 5, 7, 6},
+  }};
+  for (const auto& face : kFaces)
+    mesh.indices.insert(mesh.indices.end(), {face[0], face[1], face[2], face[0], face[2], face[3]});
+  return mesh;
+}
+
+size_t icosphere_triangle_count(int subdivisions) {
+  return size_t{20} << (2 * subdivisions);
+}
+
+size_t icosphere_vertex_count(int subdivisions) {
+  return (size_t{10} << (2 * subdivisions)) + 2;
+}
+
+TriangleMesh icosphere_mesh(const Vec3& center, double radius, int subdivisions) {
+  // The icosahedron: cyclic permutations of (0, +-1, +-phi), on the unit sphere.
+  const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3> unit = {{-1, phi, 0}, {1, phi, 0}, {-1, -phi, 0}, {1, -phi, 0},
+                            {0, -1, phi}, {0, 1, phi}, {0, -1, -phi}, {0, 1, -phi},
+                            {phi, 0, -1}, {phi, 0, 1}, {-phi, 0, -1}, {-phi, 0, 1}};
+  for (Vec3& p : unit) p = normalize(p);
+  std::vector<uint32_t> indices = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7, 10, 0, 10, 11,
+                                   1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7, 6,  7, 1,  8,
+                                   3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6, 8,  3, 8,  9,
+                                   4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6, 7,  9, 8,  1};
+
+  // Split every triangle into 4; the midpoint of an edge is shared by its two triangles.
+  for (int level = 0; level < subdivisions; ++level) {
+    std::unordered_map<uint64_t, uint32_t> midpoints;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+      uint64_t key = (uint64_t{std::min(a, b)} << 32) | std::max(a, b);
+      auto [it, inserted] = midpoints.try_emplace(key, static_cast<uint32_t>(unit.size()));
+      if (inserted) unit.push_back(normalize(unit[a] + unit[b]));
+      return it->second;
+    };
+    std::vector<uint32_t> finer;
+    finer.reserve(indices.size() * 4);
+    for (size_t t = 0; t < indices.size(); t += 3) {
+      uint32_t a = indices[t], b = indices[t + 1], c = indices[t + 2];
+      uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+      finer.insert(finer.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+    }
+    indices = std::move(finer);
+  }
+
+  TriangleMesh mesh;
+  mesh.positions.reserve(unit.size());
+  for (const Vec3& p : unit) mesh.positions.push_back(center + radius * p);
+  mesh.indices = std::move(indices);
+  return mesh;
+}
+
+TriangleMesh obj_mesh(const std::string& obj_bytes, const Vec3& scale, const Vec3& translate) {
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warning, error;
+  std::istringstream stream(obj_bytes);
+  // No material reader: `mtllib` lines are ignored, so parsing never touches the filesystem.
+  bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warning, &error, &stream,
+                             /*readMatFn=*/nullptr, /*triangulate=*/true,
+                             /*default_vcols_fallback=*/false);
+  if (!ok) throw std::invalid_argument("OBJ parse error: " + error);
+  if (attrib.vertices.size() % 3 != 0) throw std::invalid_argument("OBJ vertex array is ragged");
+
+  TriangleMesh mesh;
+  size_t vertex_count = attrib.vertices.size() / 3;
+  mesh.positions.reserve(vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    Vec3 p{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
+    if (!is_finite(p))
+      throw std::invalid_argument("OBJ vertex " + std::to_string(v + 1) + " is not finite");
+    mesh.positions.push_back(scale * p + translate);
+  }
+  for (const tinyobj::shape_t& shape : shapes) {
+    const auto& face_sizes = shape.mesh.num_face_vertices;
+    size_t offset = 0;
+    for (size_t face = 0; face < face_sizes.size(); ++face) {
+      size_t corners = face_sizes[face];
+      if (offset + corners > shape.mesh.indices.size())
+        throw std::invalid_argument("OBJ face list of '" + shape.name + "' is truncated");
+      // Triangulation is on, so faces have 3 corners; points and lines (1-2) are skipped.
+      if (corners == 3) {
+        for (size_t k = 0; k < 3; ++k) {
+          int index = shape.mesh.indices[offset + k].vertex_index;
+          if (index < 0 || static_cast<size_t>(index) >= vertex_count)
+            throw std::invalid_argument("OBJ face " + std::to_string(face + 1) + " of '" +
+                                        shape.name + "' has vertex index out of range");
+          mesh.indices.push_back(static_cast<uint32_t>(index));
+        }
+      }
+      offset += corners;
+    }
+  }
+  if (mesh.indices.empty()) throw std::invalid_argument("OBJ file has no triangles");
+  return mesh;
+}
+
+}  // namespace penumbra
