@@ -1,5 +1,6 @@
 #include "core/sampling/low_discrepancy.h"
 
+#include <algorithm>
 #include <array>
 
 #include "core/sampling/counter_random.h"
@@ -34,18 +35,6 @@ constexpr uint8_t kPermutations3[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
 constexpr uint8_t kInversePermutations3[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
                                                  {2, 0, 1}, {1, 2, 0}, {2, 1, 0}};
 
-// The random flip of the base-2 digit at tree node (level, prefix): 0 or 1.
-inline uint32_t base2_node_flip(uint64_t seed, int level, uint64_t prefix) {
-  uint64_t node = (uint64_t{1} << level) | prefix;  // unique per (level, prefix)
-  return static_cast<uint32_t>(mix_bits(seed ^ (node * kGolden)) >> 63);
-}
-
-// The random permutation (index into kPermutations3) of the base-3 digit at node (level, prefix).
-inline int base3_node_permutation(uint64_t seed, int level, uint64_t prefix) {
-  uint64_t node = (static_cast<uint64_t>(level) << 56) ^ prefix;  // prefix < 3^32 < 2^56
-  return static_cast<int>(mix_bits(seed ^ kBase3Salt ^ (node * kGolden)) % 6);
-}
-
 }  // namespace
 
 double radical_inverse(uint32_t base, uint64_t index) {
@@ -74,66 +63,91 @@ int digits_to_separate(uint32_t base, uint64_t n) {
   return digits;
 }
 
+uint64_t owen_seed(const StreamRandom& stream, uint32_t dimension) {
+  return stream.bits(kStreamDrawSample, kOwenSeedDimension + dimension);
+}
+
 uint64_t owen_seed(const StreamKey& key, uint32_t dimension) {
-  return StreamRandom(key).bits(kStreamDrawSample, kOwenSeedDimension + dimension);
+  return owen_seed(StreamRandom(key), dimension);
 }
 
-uint32_t owen_scramble_base2(uint32_t bits, int levels, uint64_t seed) {
-  uint32_t scrambled = bits;
-  for (int level = 0; level < levels; ++level) {
-    uint64_t prefix = level == 0 ? 0 : bits >> (32 - level);
-    scrambled ^= base2_node_flip(seed, level, prefix) << (31 - level);
-  }
-  return scrambled;
+OwenScramblerBase2::OwenScramblerBase2(uint64_t seed, int levels, bool keep_words)
+    : seed_(seed), levels_(levels) {
+  // Node ids of `levels` levels are below 2^levels: 64 per word.
+  uint64_t words_needed = levels <= 0 ? 0 : ((uint64_t{1} << levels) + 63) >> 6;
+  kept_ = keep_words ? static_cast<uint32_t>(std::min<uint64_t>(words_needed, kKeptWords)) : 0;
+  for (uint32_t i = 0; i < kept_; ++i) words_[i] = word(i);
 }
 
-uint32_t owen_unscramble_base2(uint32_t scrambled, int levels, uint64_t seed) {
-  // Restore the digits from the top: each flip depends only on the digits above it.
-  uint32_t bits = scrambled;
-  for (int level = 0; level < levels; ++level) {
-    uint64_t prefix = level == 0 ? 0 : bits >> (32 - level);
-    bits ^= base2_node_flip(seed, level, prefix) << (31 - level);
-  }
-  return bits;
+uint64_t OwenScramblerBase2::word(uint64_t index) const {
+  return mix_bits(seed_ ^ (index * kGolden));
 }
 
-uint64_t owen_scramble_base3(uint64_t index, int levels, uint64_t seed) {
-  // Digit k of the radical inverse is digit k of the index (least significant first); the node
-  // of digit k is the index modulo 3^k.
-  uint64_t scrambled_digits = 0;
-  uint64_t prefix = 0;
+OwenScramblerBase3::OwenScramblerBase3(uint64_t seed, int levels, bool keep_words)
+    : seed_(seed), levels_(levels) {
+  // Node ids of `levels` levels are below (3^levels - 1) / 2: 2 per word.
+  uint64_t nodes = 0;
   uint64_t place = 1;
-  for (int level = 0; level < levels; ++level) {
+  for (int level = 0; level < levels && nodes < 2 * kKeptWords; ++level, place *= 3) {
+    nodes += place;
+  }
+  uint64_t words_needed = (nodes + 1) / 2;
+  kept_ = keep_words ? static_cast<uint32_t>(std::min<uint64_t>(words_needed, kKeptWords)) : 0;
+  for (uint32_t i = 0; i < kept_; ++i) words_[i] = word(i);
+}
+
+uint64_t OwenScramblerBase3::word(uint64_t index) const {
+  return mix_bits(seed_ ^ kBase3Salt ^ (index * kGolden));
+}
+
+uint64_t OwenScramblerBase3::scramble(uint64_t index) const {
+  uint64_t scrambled_digits = 0;
+  uint64_t prefix = 0;     // index mod 3^level
+  uint64_t place = 1;      // 3^level
+  uint64_t level_ids = 0;  // id of the first node of this level, (3^level - 1) / 2
+  for (int level = 0; level < levels_; ++level) {
     uint32_t digit = static_cast<uint32_t>(index % 3);
     index /= 3;
-    int permutation = base3_node_permutation(seed, level, prefix);
-    scrambled_digits = scrambled_digits * 3 + kPermutations3[permutation][digit];
+    int chosen = permutation(level_ids + prefix);
+    scrambled_digits = scrambled_digits * 3 + kPermutations3[chosen][digit];
     prefix += digit * place;
+    level_ids += place;
     place *= 3;
   }
   return scrambled_digits;
 }
 
-uint64_t owen_unscramble_base3(uint64_t scrambled_digits, int levels, uint64_t seed) {
+uint64_t OwenScramblerBase3::unscramble(uint64_t scrambled_digits) const {
   uint64_t top_place = 1;
-  for (int level = 1; level < levels; ++level) top_place *= 3;
+  for (int level = 1; level < levels_; ++level) top_place *= 3;
   uint64_t prefix = 0;
   uint64_t place = 1;
-  for (int level = 0; level < levels; ++level) {
+  uint64_t level_ids = 0;
+  for (int level = 0; level < levels_; ++level) {
     uint32_t scrambled = static_cast<uint32_t>((scrambled_digits / top_place) % 3);
     top_place /= 3;
-    int permutation = base3_node_permutation(seed, level, prefix);
-    prefix += kInversePermutations3[permutation][scrambled] * place;
+    int chosen = permutation(level_ids + prefix);
+    prefix += kInversePermutations3[chosen][scrambled] * place;
+    level_ids += place;
     place *= 3;
   }
   return prefix;
 }
 
-double fraction_from_base2_digits(uint32_t top_bits, int levels, uint64_t random_bits) {
-  if (levels <= 0) return bits_to_unit_double(random_bits);
-  uint64_t digits = top_bits >> (32 - levels);
-  uint64_t value53 = (digits << (53 - levels)) | (random_bits >> (11 + levels));
-  return static_cast<double>(value53) * 0x1.0p-53;
+uint32_t owen_scramble_base2(uint32_t bits, int levels, uint64_t seed) {
+  return OwenScramblerBase2(seed, levels, false).scramble(bits);
+}
+
+uint32_t owen_unscramble_base2(uint32_t scrambled, int levels, uint64_t seed) {
+  return OwenScramblerBase2(seed, levels, false).unscramble(scrambled);
+}
+
+uint64_t owen_scramble_base3(uint64_t index, int levels, uint64_t seed) {
+  return OwenScramblerBase3(seed, levels, false).scramble(index);
+}
+
+uint64_t owen_unscramble_base3(uint64_t scrambled_digits, int levels, uint64_t seed) {
+  return OwenScramblerBase3(seed, levels, false).unscramble(scrambled_digits);
 }
 
 }  // namespace penumbra

@@ -62,7 +62,7 @@ class Permutation {
   static constexpr uint32_t kInline = 64;
   uint32_t* data() { return size_ > kInline ? heap_.data() : inline_.data(); }
   uint32_t size_;
-  std::array<uint32_t, kInline> inline_{};
+  std::array<uint32_t, kInline> inline_;  // filled by the constructor
   std::vector<uint32_t> heap_;
 };
 
@@ -116,8 +116,9 @@ void correlated_multi_jittered(const StreamRandom& rng, const StrataGrid& grid,
 // Owen-scrambled base-2 coordinate of point `index`: `unscrambled` holds its digits as a 0.32
 // fraction, of which the first `levels` separate the stream's points (low_discrepancy.h).
 inline double scrambled_base2(const StreamRandom& rng, uint32_t index, uint32_t dimension,
-                              uint32_t unscrambled, int levels, uint64_t seed) {
-  return fraction_from_base2_digits(owen_scramble_base2(unscrambled, levels, seed), levels,
+                              uint32_t unscrambled, int levels,
+                              const OwenScramblerBase2& scrambler) {
+  return fraction_from_base2_digits(scrambler.scramble(unscrambled), levels,
                                     rng.bits(index, dimension));
 }
 
@@ -172,9 +173,9 @@ void generate_1d(Pattern pattern, const StreamKey& key, std::span<double> out) {
     case Pattern::Halton:
     case Pattern::Sobol: {
       int levels = digits_to_separate(2, n);
-      uint64_t seed = owen_seed(key, 0);
+      OwenScramblerBase2 scrambler(owen_seed(rng, 0), levels);
       for (uint32_t i = 0; i < n; ++i) {
-        out[i] = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels, seed);
+        out[i] = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels, scrambler);
       }
       return;
     }
@@ -206,23 +207,23 @@ void generate_2d(Pattern pattern, const StreamKey& key, double aspect, std::span
       int levels3 = digits_to_separate(3, n);
       uint64_t strata3 = 1;
       for (int level = 0; level < levels3; ++level) strata3 *= 3;
-      uint64_t seed_x = owen_seed(key, 0);
-      uint64_t seed_y = owen_seed(key, 1);
+      OwenScramblerBase2 scrambler_x(owen_seed(rng, 0), levels2);
+      OwenScramblerBase3 scrambler_y(owen_seed(rng, 1), levels3);
       for (uint32_t i = 0; i < n; ++i) {
-        double x = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels2, seed_x);
+        double x = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels2, scrambler_x);
         // Base 3: the scrambled digits pick one of 3^levels3 strata, the rest is uniform in it.
-        uint64_t stratum = owen_scramble_base3(i, levels3, seed_y);
+        uint64_t stratum = scrambler_y.scramble(i);
         out[i] = {x, point_in_stratum(stratum, strata3, rng.uniform(i, 1))};
       }
       return;
     }
     case Pattern::Sobol: {
       int levels = digits_to_separate(2, n);
-      uint64_t seed_x = owen_seed(key, 0);
-      uint64_t seed_y = owen_seed(key, 1);
+      OwenScramblerBase2 scrambler_x(owen_seed(rng, 0), levels);
+      OwenScramblerBase2 scrambler_y(owen_seed(rng, 1), levels);
       for (uint32_t i = 0; i < n; ++i) {
-        out[i] = {scrambled_base2(rng, i, 0, sobol_bits(i, 0), levels, seed_x),
-                  scrambled_base2(rng, i, 1, sobol_bits(i, 1), levels, seed_y)};
+        out[i] = {scrambled_base2(rng, i, 0, sobol_bits(i, 0), levels, scrambler_x),
+                  scrambled_base2(rng, i, 1, sobol_bits(i, 1), levels, scrambler_y)};
       }
       return;
     }

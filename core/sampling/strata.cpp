@@ -8,10 +8,10 @@
 
 namespace penumbra {
 
-double point_in_stratum(uint64_t index, uint64_t count, double u) {
+double point_in_stratum_nudged(uint64_t index, uint64_t count, double u) {
   double strata = static_cast<double>(count);
   double target = static_cast<double>(index);
-  u = std::clamp(u, 0.0, kOneMinusEpsilon);
+  u = u >= 0.0 ? std::min(u, kOneMinusEpsilon) : 0.0;  // also NaN to 0
   double v = std::min((target + u) / strata, kOneMinusEpsilon);
   // Both the sum and the division round: a value within an ulp of a stratum boundary can land on
   // the wrong side of it. Step it back one ulp at a time (at most a few steps).

@@ -12,7 +12,10 @@ namespace penumbra {
 // The point at relative position u in [0,1) of stratum `index` of `count` (index < count):
 // (index + u) / count, nudged by at most a few ulps so that floor(v * count) == index in double
 // arithmetic. Always in [0,1).
-double point_in_stratum(uint64_t index, uint64_t count, double u);
+inline double point_in_stratum(uint64_t index, uint64_t count, double u);
+
+// The rare path of point_in_stratum: u outside [0,1), or a value rounded across a boundary.
+double point_in_stratum_nudged(uint64_t index, uint64_t count, double u);
 
 // The stratum of v among `count` equal strata (the convention above), clamped to [0, count).
 uint64_t stratum_of(double v, uint64_t count);
@@ -39,5 +42,15 @@ struct StrataGrid {
   uint32_t cells() const { return columns * rows; }
 };
 StrataGrid strata_grid(uint32_t n, double aspect);
+
+inline double point_in_stratum(uint64_t index, uint64_t count, double u) {
+  double strata = static_cast<double>(count);
+  double target = static_cast<double>(index);
+  double v = (target + u) / strata;
+  double scaled = v * strata;
+  // Almost always already inside (also false for NaN, which the slow path resolves).
+  if (v < 1.0 && scaled >= target && scaled < target + 1.0) return v;
+  return point_in_stratum_nudged(index, count, u);
+}
 
 }  // namespace penumbra
