@@ -3,6 +3,7 @@
 //   DirectSample/M   one whole direct-light sample of method M at a shading point (strategy
 //                    sample, shading, pdfs, MIS and the shadow ray), as a ratio to ShadowRay
 //   Render512x16     the whole 512x512, 16 spp render with `sa` (seconds; peak RSS)
+//   ShadowRay16, CameraRay1, CameraRay16: the query APIs compared (single rays vs packets)
 // Run: build/release/bench/render_bench --benchmark_min_time=1
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -66,6 +67,83 @@ void ShadowRay(benchmark::State& state) {
 }
 BENCHMARK(ShadowRay);
 
+// The same shadow rays as 16-wide packets of neighbouring shading points (rtcOccluded16).
+void ShadowRay16(benchmark::State& state) {
+  SceneShading shading(bench_scene(), parse_method("sa"));
+  const Workload& w = workload(shading);
+  RTCScene rtc = shading.embree().rtc_scene();
+  const double eps = shading.embree().ray_epsilon();
+  size_t base = 0, hits = 0;
+  alignas(64) int valid[16];
+  for (int k = 0; k < 16; ++k) valid[k] = -1;
+  for (auto _ : state) {
+    RTCRay16 rays;
+    for (int k = 0; k < 16; ++k) {
+      size_t i = (base + k) % w.points.size();
+      Vec3 o = w.points[i].position + w.points[i].normal * eps;
+      Vec3 d = w.light_points[i] - o;
+      double len = length(d);
+      d = d / len;
+      rays.org_x[k] = float(o.x), rays.org_y[k] = float(o.y), rays.org_z[k] = float(o.z);
+      rays.dir_x[k] = float(d.x), rays.dir_y[k] = float(d.y), rays.dir_z[k] = float(d.z);
+      rays.tnear[k] = 0, rays.tfar[k] = float(len - eps), rays.mask[k] = ~0u;
+      rays.time[k] = 0, rays.flags[k] = 0, rays.id[k] = k;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    rtcOccluded16(valid, rtc, &context, &rays);
+    for (int k = 0; k < 16; ++k) hits += rays.tfar[k] < 0;
+    base += 16;
+  }
+  benchmark::DoNotOptimize(hits);
+  state.SetItemsProcessed(state.iterations() * 16);
+}
+BENCHMARK(ShadowRay16);
+
+// Camera rays: single rays against 16-wide packets on 4x4 pixel blocks.
+void CameraRay1(benchmark::State& state) {
+  SceneShading shading(bench_scene(), parse_method("sa"));
+  CameraRays camera(shading.scene().camera);
+  int x = 0, y = 0, hits = 0;
+  for (auto _ : state) {
+    hits += bool(shading.embree().intersect(camera.origin(), camera.direction(x + 0.5, y + 0.5)));
+    if (++x == shading.scene().camera.width) x = 0, y = (y + 1) % shading.scene().camera.height;
+  }
+  benchmark::DoNotOptimize(hits);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(CameraRay1);
+
+void CameraRay16(benchmark::State& state) {
+  SceneShading shading(bench_scene(), parse_method("sa"));
+  const Camera& cam = shading.scene().camera;
+  CameraRays camera(cam);
+  RTCScene rtc = shading.embree().rtc_scene();
+  alignas(64) int valid[16];
+  for (int k = 0; k < 16; ++k) valid[k] = -1;
+  int bx = 0, by = 0, hits = 0;
+  for (auto _ : state) {
+    RTCRayHit16 rh;
+    for (int k = 0; k < 16; ++k) {
+      Vec3 d = camera.direction(bx + (k % 4) + 0.5, by + (k / 4) + 0.5);
+      rh.ray.org_x[k] = float(camera.origin().x), rh.ray.org_y[k] = float(camera.origin().y);
+      rh.ray.org_z[k] = float(camera.origin().z);
+      rh.ray.dir_x[k] = float(d.x), rh.ray.dir_y[k] = float(d.y), rh.ray.dir_z[k] = float(d.z);
+      rh.ray.tnear[k] = 0, rh.ray.tfar[k] = 1e30f, rh.ray.mask[k] = ~0u, rh.ray.time[k] = 0;
+      rh.ray.flags[k] = 0, rh.ray.id[k] = k, rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    rtcIntersect16(valid, rtc, &context, &rh);
+    for (int k = 0; k < 16; ++k) hits += rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+    bx += 4;
+    if (bx >= cam.width) bx = 0, by = (by + 4) % (cam.height - 3);
+  }
+  benchmark::DoNotOptimize(hits);
+  state.SetItemsProcessed(state.iterations() * 16);
+}
+BENCHMARK(CameraRay16);
+
 void DirectSample(benchmark::State& state, const char* method) {
   SceneShading shading(bench_scene(), parse_method(method));
   const Workload& w = workload(shading);
@@ -85,6 +163,7 @@ BENCHMARK_CAPTURE(DirectSample, sa, "sa");
 BENCHMARK_CAPTURE(DirectSample, area, "area");
 BENCHMARK_CAPTURE(DirectSample, bsdf, "bsdf");
 BENCHMARK_CAPTURE(DirectSample, bsdf_sa_balance, "bsdf+sa/balance");
+BENCHMARK_CAPTURE(DirectSample, psa, "psa");
 
 void Render512x16(benchmark::State& state) {
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);

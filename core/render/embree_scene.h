@@ -38,6 +38,9 @@ class EmbreeScene {
   // facing the segment) to `to` (on a light). Both ends are excluded by a relative epsilon.
   bool occluded(const Vec3& from, const Vec3& normal, const Vec3& to) const;
 
+  // The Embree scene itself, for benchmarks of other query APIs (packets, streams).
+  RTCScene rtc_scene() const { return scene_; }
+
   // Offset used for ray origins: scene-scale relative.
   double ray_epsilon() const { return ray_epsilon_; }
 
