@@ -294,14 +294,11 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
 void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, IntervalList& out,
                                   LineQueryStats* stats) const {
   out.reset();
-  if (!is_finite(x) || !is_finite(a) || !is_finite(b)) {
-    out.clear();
-    return;
-  }
   std::optional<ShadowTriangle> shadow = ShadowTriangle::make(x, a, b, options_.tolerances);
   if (!shadow) {
-    // Degenerate shadow triangle: the segment is seen along one direction.
-    if (occluded(x, 0.5 * (a + b))) out.clear();
+    // Non-finite input: nothing visible. Degenerate shadow triangle: the segment is seen along
+    // one direction, one shadow ray decides.
+    if (!is_finite(x) || !is_finite(a) || !is_finite(b) || occluded(x, 0.5 * (a + b))) out.clear();
     return;
   }
   if (nodes_.empty()) return;

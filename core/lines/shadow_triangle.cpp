@@ -6,7 +6,6 @@ namespace penumbra {
 
 std::optional<ShadowTriangle> ShadowTriangle::make(const Vec3& x, const Vec3& a, const Vec3& b,
                                                    const ShadowTriangleTolerances& tolerances) {
-  if (!is_finite(x) || !is_finite(a) || !is_finite(b)) return std::nullopt;
   Vec3 to_a = a - x, to_b = b - x, segment = b - a;
   // cross(to_a, to_b) == cross(to_a, segment); the latter does not cancel when x is far away
   // (to_a and to_b nearly parallel).
@@ -15,13 +14,14 @@ std::optional<ShadowTriangle> ShadowTriangle::make(const Vec3& x, const Vec3& a,
   // Degenerate when the angle at x is below ~1e-10 rad (a == b, x on the segment's line) or
   // when the squared lengths leave the double range.
   double scale = length_squared(to_a) * length_squared(to_b);
+  // (Non-finite input fails here too: NaN and infinity make `scale` NaN or infinite.)
   if (!(normal_length_squared > 1e-20 * scale) || !std::isfinite(scale)) return std::nullopt;
 
   std::optional<ShadowTriangle> result(std::in_place);  // filled in place (no copy)
   ShadowTriangle& shadow = *result;
   shadow.x = x;
-  shadow.a = a;
-  shadow.b = b;
+  shadow.to_a = to_a;
+  shadow.to_b = to_b;
   // alpha(a) = 1, alpha(b) = 0 and beta(a) = 0, beta(b) = 1, both 0 along the plane normal.
   double inverse = 1 / normal_length_squared;
   shadow.alpha_gradient = cross(to_b, normal) * inverse;
@@ -36,7 +36,9 @@ std::optional<ShadowTriangle> ShadowTriangle::make(const Vec3& x, const Vec3& a,
       shadow.s_min * std::sqrt(normal_length_squared / length_squared(segment));
   shadow.self_occlusion_distance_squared =
       shadow.self_occlusion_distance * shadow.self_occlusion_distance;
-  if (!is_finite(shadow.alpha_gradient) || !is_finite(shadow.beta_gradient)) return std::nullopt;
+  // Finite whenever the checks above pass; guarded anyway (one test for six values).
+  double sum = dot(shadow.alpha_gradient, Vec3(1, 1, 1)) + dot(shadow.beta_gradient, Vec3(1, 1, 1));
+  if (!std::isfinite(sum)) return std::nullopt;
   return result;
 }
 
@@ -71,8 +73,8 @@ std::optional<Interval> occluder_cut(const ShadowTriangle& shadow,
   double x_side = dot(occluder_normal, shadow.x - v[0]);
   if (x_side * x_side <= shadow.self_occlusion_distance_squared * length_squared(occluder_normal))
     return std::nullopt;
-  double a_side = dot(occluder_normal, shadow.a - v[0]);
-  double b_side = dot(occluder_normal, shadow.b - v[0]);
+  double a_side = x_side + dot(occluder_normal, shadow.to_a);
+  double b_side = x_side + dot(occluder_normal, shadow.to_b);
   if (x_side > 0 && a_side > 0 && b_side > 0) return std::nullopt;
   if (x_side < 0 && a_side < 0 && b_side < 0) return std::nullopt;
 

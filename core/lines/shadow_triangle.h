@@ -41,7 +41,7 @@ struct ShadowTriangleTolerances {
 };
 
 struct ShadowTriangle {
-  Vec3 x, a, b;
+  Vec3 x, to_a, to_b;                                // the shading point; a - x and b - x
   Vec3 alpha_gradient, beta_gradient, plane_normal;  // see the file comment
   double s_min = 0, s_max = 1;
   // s_min as a distance: s_min times the distance from x to the segment's line. An occluder
