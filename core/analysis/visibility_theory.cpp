@@ -35,11 +35,12 @@ double radical_inverse_base2(uint32_t index) {
   return inverse;
 }
 
-// E[f(1-f)] for the visible fraction f of an interval cut by j independent uniform
-// discontinuities: the j+1 spacings are Dirichlet(1,...,1), f is the sum of m = floor((j+1)/2)
-// of them (the visible ones; m(j+1-m) is the same whichever state the interval starts in), so f
-// is Beta(m, j+1-m) and E[f(1-f)] = m(j+1-m) / ((j+1)(j+2)).
-double expected_visible_fraction_variance(int j) {
+// E[f(1-f)], the variance of the visibility of one uniform sample of an interval averaged over
+// the interval's visible fraction f, when j independent uniform discontinuities cut it: the j+1
+// spacings are Dirichlet(1,...,1), f is the sum of m = floor((j+1)/2) of them (the visible ones;
+// m(j+1-m) is the same whichever state the interval starts in), so f is Beta(m, j+1-m) and
+// E[f(1-f)] = m(j+1-m) / ((j+1)(j+2)).
+double expected_visibility_sample_variance(int j) {
   double m = double((j + 1) / 2);
   return m * (double(j + 1) - m) / (double(j + 1) * double(j + 2));
 }
@@ -203,10 +204,10 @@ std::optional<PredictedError> predicted_squared_error(VisibilityPattern pattern,
 
   // Random sampling ignores strata: each sample sees the visible set with probability S, so
   // <(S - S_bar)^2> = E[S(1-S)]/N, "1/N times the variance of the step"; for k independent
-  // uniform discontinuities S is Beta(m, k+1-m) (see expected_visible_fraction_variance).
+  // uniform discontinuities S is Beta(m, k+1-m) (see expected_visibility_sample_variance).
   if (pattern == VisibilityPattern::Random) {
     if (placement != DiscontinuityPlacement::Independent && k > 1) return std::nullopt;
-    return PredictedError{expected_visible_fraction_variance(k) / n,
+    return PredictedError{expected_visibility_sample_variance(k) / n,
                           "m(k+1-m)/((k+1)(k+2) N), m=floor((k+1)/2)",
                           "variance of a Bernoulli(S) sample / N"};
   }
@@ -230,7 +231,7 @@ std::optional<PredictedError> predicted_squared_error(VisibilityPattern pattern,
     if (pattern != VisibilityPattern::Stratified) return std::nullopt;
     double per_stratum = 0;
     for (int j = 1; j <= k; ++j)
-      per_stratum += binomial_probability(k, j, 1.0 / n) * expected_visible_fraction_variance(j);
+      per_stratum += binomial_probability(k, j, 1.0 / n) * expected_visibility_sample_variance(j);
     return PredictedError{n * per_stratum / n2, "sum_j Binom(j; k, 1/N) m(j+1-m)/((j+1)(j+2)) / N",
                           "Eq. 11-12 per stratum, strata independent"};
   }
