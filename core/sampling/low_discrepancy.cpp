@@ -134,6 +134,41 @@ uint64_t OwenScramblerBase3::unscramble(uint64_t scrambled_digits) const {
   return prefix;
 }
 
+void OwenScramblerBase2::fill_table(std::span<uint32_t> table) const {
+  // Level by level, in place: entry p of the first k digits (digit 0 on top) splits into entries
+  // 2p and 2p + 1 at digit k, flipped by node (k, p). Descending p never overwrites an entry
+  // before it is read.
+  table[0] = 0;
+  for (int level = 0; level < levels_; ++level) {
+    uint64_t level_ids = uint64_t{1} << level;
+    for (uint64_t p = level_ids; p-- > 0;) {
+      uint32_t flipped = flip(level_ids | p);
+      uint32_t parent = table[p] << 1;
+      table[2 * p] = parent | flipped;
+      table[2 * p + 1] = parent | (flipped ^ 1u);
+    }
+  }
+}
+
+void OwenScramblerBase3::fill_table(std::span<uint64_t> table) const {
+  // As in base 2, in place: entry i < 3^k splits into i, i + 3^k, i + 2 3^k at digit k. The node
+  // of digit k of index i is i mod 3^k, the entry itself.
+  table[0] = 0;
+  uint64_t place = 1;
+  uint64_t level_ids = 0;
+  for (int level = 0; level < levels_; ++level) {
+    for (uint64_t i = 0; i < place; ++i) {
+      const uint8_t* chosen = kPermutations3[permutation(level_ids + i)];
+      uint64_t parent = table[i] * 3;
+      table[i] = parent + chosen[0];
+      table[i + place] = parent + chosen[1];
+      table[i + 2 * place] = parent + chosen[2];
+    }
+    level_ids += place;
+    place *= 3;
+  }
+}
+
 uint32_t owen_scramble_base2(uint32_t bits, int levels, uint64_t seed) {
   return OwenScramblerBase2(seed, levels, false).scramble(bits);
 }

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "core/sampling/pattern.h"
 
@@ -73,6 +74,10 @@ class OwenScramblerBase2 {
     }
     return bits;
   }
+  // Every scramble() of the first `levels` digits at once, for a whole stream of points: entry t
+  // (t < 2^levels) is scramble(t << (32 - levels)) >> (32 - levels). Built level by level, about
+  // 2 steps per entry where scramble() takes `levels` steps per point.
+  void fill_table(std::span<uint32_t> table) const;
 
  private:
   static constexpr uint32_t kKeptWords = 64;  // node ids below 2^12
@@ -100,6 +105,8 @@ class OwenScramblerBase3 {
   uint64_t scramble(uint64_t index) const;
   // The inverse: the index modulo 3^levels whose scrambled digits these are.
   uint64_t unscramble(uint64_t scrambled_digits) const;
+  // Every scramble() at once: entry i (i < 3^levels) is scramble(i). About 1.5 steps per entry.
+  void fill_table(std::span<uint64_t> table) const;
 
  private:
   static constexpr uint32_t kKeptWords = 192;  // the (3^6 - 1)/2 = 364 nodes of 6 levels

@@ -43,27 +43,93 @@ inline uint32_t bounded_index(uint64_t bits, uint32_t bound) {
   return static_cast<uint32_t>(((bits >> 32) * bound) >> 32);
 }
 
+// An array whose storage is inline for small sizes, so small patterns never allocate.
+template <typename T>
+class SmallBuffer {
+ public:
+  explicit SmallBuffer(size_t size) : size_(size) {
+    if (size > kInline) heap_.resize(size);
+  }
+  T* data() { return size_ > kInline ? heap_.data() : inline_.data(); }
+  std::span<T> span() { return {data(), size_}; }
+  T operator[](size_t i) const { return size_ > kInline ? heap_[i] : inline_[i]; }
+
+ private:
+  static constexpr size_t kInline = 128;
+  size_t size_;
+  std::array<T, kInline> inline_;  // filled by the owner
+  std::vector<T> heap_;
+};
+
 // A uniformly random permutation of [0, size) (Fisher & Yates), drawn from the stream's
-// (sample, j) numbers. The storage is inline for small sizes, so small patterns never allocate.
+// (sample, j) numbers.
 class Permutation {
  public:
-  Permutation(const StreamRandom& rng, uint32_t sample, uint32_t size) : size_(size) {
-    if (size > kInline) heap_.resize(size);
-    uint32_t* p = data();
+  Permutation(const StreamRandom& rng, uint32_t sample, uint32_t size) : values_(size) {
+    uint32_t* p = values_.data();
     for (uint32_t i = 0; i < size; ++i) p[i] = i;
     for (uint32_t i = size; i > 1; --i) {
       uint32_t j = bounded_index(rng.bits(sample, i - 1), i);
       std::swap(p[i - 1], p[j]);
     }
   }
-  uint32_t operator[](uint32_t i) const { return size_ > kInline ? heap_[i] : inline_[i]; }
+  uint32_t operator[](uint32_t i) const { return values_[i]; }
 
  private:
-  static constexpr uint32_t kInline = 64;
-  uint32_t* data() { return size_ > kInline ? heap_.data() : inline_.data(); }
-  uint32_t size_;
-  std::array<uint32_t, kInline> inline_;  // filled by the constructor
-  std::vector<uint32_t> heap_;
+  SmallBuffer<uint32_t> values_;
+};
+
+// Above this many digits the scrambled-digit tables (2^levels or 3^levels entries) would cost
+// more memory than they save time: scramble point by point instead.
+constexpr int kMaxTableLevelsBase2 = 16;
+constexpr int kMaxTableLevelsBase3 = 10;
+
+// The scrambled first `levels` base-2 digits of the stream's points: a table when it is small,
+// else scramble() per point. With 0 levels there is nothing to scramble (and no seed to draw).
+class ScrambledBase2Digits {
+ public:
+  ScrambledBase2Digits(const StreamRandom& rng, uint32_t dimension, int levels)
+      : scrambler_(levels > 0 ? owen_seed(rng, dimension) : 0, levels),
+        levels_(levels),
+        table_(levels <= kMaxTableLevelsBase2 ? size_t{1} << levels : 0) {
+    if (levels > 0 && levels <= kMaxTableLevelsBase2) scrambler_.fill_table(table_.span());
+  }
+  // The scrambled digits of the point whose unscrambled 0.32 fraction is `bits` (all digits
+  // below `levels` zero), as a 0.32 fraction.
+  uint32_t scramble(uint32_t bits) const {
+    if (levels_ == 0) return 0;
+    if (levels_ > kMaxTableLevelsBase2) return scrambler_.scramble(bits);
+    return table_[bits >> (32 - levels_)] << (32 - levels_);
+  }
+
+ private:
+  OwenScramblerBase2 scrambler_;
+  int levels_;
+  SmallBuffer<uint32_t> table_;
+};
+
+class ScrambledBase3Digits {
+ public:
+  ScrambledBase3Digits(const StreamRandom& rng, uint32_t dimension, int levels)
+      : scrambler_(levels > 0 ? owen_seed(rng, dimension) : 0, levels),
+        levels_(levels),
+        table_(levels <= kMaxTableLevelsBase3 ? power_of_three(levels) : 0) {
+    if (levels > 0 && levels <= kMaxTableLevelsBase3) scrambler_.fill_table(table_.span());
+  }
+  uint64_t scramble(uint32_t index) const {
+    if (levels_ == 0) return 0;
+    return levels_ <= kMaxTableLevelsBase3 ? table_[index] : scrambler_.scramble(index);
+  }
+  static uint64_t power_of_three(int exponent) {
+    uint64_t p = 1;
+    for (int i = 0; i < exponent; ++i) p *= 3;
+    return p;
+  }
+
+ private:
+  OwenScramblerBase3 scrambler_;
+  int levels_;
+  SmallBuffer<uint64_t> table_;
 };
 
 // Places the samples of a strata-grid pattern: `position_in_stratum(i)` gives sample i's relative
@@ -116,10 +182,8 @@ void correlated_multi_jittered(const StreamRandom& rng, const StrataGrid& grid,
 // Owen-scrambled base-2 coordinate of point `index`: `unscrambled` holds its digits as a 0.32
 // fraction, of which the first `levels` separate the stream's points (low_discrepancy.h).
 inline double scrambled_base2(const StreamRandom& rng, uint32_t index, uint32_t dimension,
-                              uint32_t unscrambled, int levels,
-                              const OwenScramblerBase2& scrambler) {
-  return fraction_from_base2_digits(scrambler.scramble(unscrambled), levels,
-                                    rng.bits(index, dimension));
+                              uint32_t scrambled_digits, int levels) {
+  return fraction_from_base2_digits(scrambled_digits, levels, rng.bits(index, dimension));
 }
 
 }  // namespace
@@ -173,9 +237,9 @@ void generate_1d(Pattern pattern, const StreamKey& key, std::span<double> out) {
     case Pattern::Halton:
     case Pattern::Sobol: {
       int levels = digits_to_separate(2, n);
-      OwenScramblerBase2 scrambler(owen_seed(rng, 0), levels);
+      ScrambledBase2Digits digits(rng, 0, levels);
       for (uint32_t i = 0; i < n; ++i) {
-        out[i] = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels, scrambler);
+        out[i] = scrambled_base2(rng, i, 0, digits.scramble(reverse_bits_32(i)), levels);
       }
       return;
     }
@@ -205,25 +269,24 @@ void generate_2d(Pattern pattern, const StreamKey& key, double aspect, std::span
     case Pattern::Halton: {
       int levels2 = digits_to_separate(2, n);
       int levels3 = digits_to_separate(3, n);
-      uint64_t strata3 = 1;
-      for (int level = 0; level < levels3; ++level) strata3 *= 3;
-      OwenScramblerBase2 scrambler_x(owen_seed(rng, 0), levels2);
-      OwenScramblerBase3 scrambler_y(owen_seed(rng, 1), levels3);
+      uint64_t strata3 = ScrambledBase3Digits::power_of_three(levels3);
+      ScrambledBase2Digits digits_x(rng, 0, levels2);
+      ScrambledBase3Digits digits_y(rng, 1, levels3);
       for (uint32_t i = 0; i < n; ++i) {
-        double x = scrambled_base2(rng, i, 0, reverse_bits_32(i), levels2, scrambler_x);
+        double x = scrambled_base2(rng, i, 0, digits_x.scramble(reverse_bits_32(i)), levels2);
         // Base 3: the scrambled digits pick one of 3^levels3 strata, the rest is uniform in it.
-        uint64_t stratum = scrambler_y.scramble(i);
+        uint64_t stratum = digits_y.scramble(i);
         out[i] = {x, point_in_stratum(stratum, strata3, rng.uniform(i, 1))};
       }
       return;
     }
     case Pattern::Sobol: {
       int levels = digits_to_separate(2, n);
-      OwenScramblerBase2 scrambler_x(owen_seed(rng, 0), levels);
-      OwenScramblerBase2 scrambler_y(owen_seed(rng, 1), levels);
+      ScrambledBase2Digits digits_x(rng, 0, levels);
+      ScrambledBase2Digits digits_y(rng, 1, levels);
       for (uint32_t i = 0; i < n; ++i) {
-        out[i] = {scrambled_base2(rng, i, 0, sobol_bits(i, 0), levels, scrambler_x),
-                  scrambled_base2(rng, i, 1, sobol_bits(i, 1), levels, scrambler_y)};
+        out[i] = {scrambled_base2(rng, i, 0, digits_x.scramble(reverse_bits_32(i)), levels),
+                  scrambled_base2(rng, i, 1, digits_y.scramble(sobol_bits(i, 1)), levels)};
       }
       return;
     }
