@@ -255,18 +255,42 @@ void ProjectedSolidAngleSampler::add_sector(const Vec2& s0, const Vec2& s1,
   s.s1 = s1;
   s.inner = inner;
   s.outer = outer;
-  // Sector areas by Peters Eq. 1; the difference of outer and inner in the decentral case.
-  double area = area_up_to(s, s1);
+  // Sector areas by Peters Eq. 1; the difference of outer and inner in the decentral case. A
+  // single ellipse also keeps its angle in the circle it maps to (for Sec. 3.2's inversion).
+  double area;
+  if (inner.c == 0) {
+    double abs_c = std::abs(outer.c);
+    s.angle = std::max(0.0, std::atan2(abs_c * cross2(s0, s1), ellipse_form(outer, s0, s1)));
+    area = 0.5 * abs_c * s.angle;
+  } else {
+    area = area_up_to(s, s1);
+  }
   s.area = std::isfinite(area) ? std::max(0.0, area) : 0.0;
-  double abs_c = std::abs(outer.c);
-  s.angle = std::max(0.0, std::atan2(abs_c * cross2(s0, s1), ellipse_form(outer, s0, s1)));
   total_area_ += s.area;
 }
 
 double ProjectedSolidAngleSampler::area_up_to(const Sector& s, const Vec2& w) const {
-  double area = ellipse_sector_area(s.outer, s.s0, w);
-  if (s.inner.c != 0) area -= ellipse_sector_area(s.inner, s.s0, w);
-  return area;
+  if (s.inner.c == 0) return ellipse_sector_area(s.outer, s.s0, w);
+  // Outer minus inner ellipse sector (Eq. 1 twice), rearranged so that nearly equal ellipses do
+  // not cancel: with alpha_l = atan2(|c_l| cross(s0, w), s0^T C_l w),
+  //   (|c_o| alpha_o - |c_i| alpha_i) / 2 = ((|c_o| - |c_i|) alpha_o + |c_i| (alpha_o - alpha_i)) /
+  //   2,
+  // |c_o| - |c_i| = (|m_i|^2 - |m_o|^2) / (|c_o| + |c_i|) (unit normals), and alpha_o - alpha_i
+  // as one arctangent. For a sliver between the horizon (m_o = 0) and an edge just above it
+  // every term keeps its relative precision, where the plain difference loses all of it.
+  const EdgeEllipse& o = s.outer;
+  const EdgeEllipse& i = s.inner;
+  double co = std::abs(o.c), ci = std::abs(i.c);
+  double cr = cross2(s.s0, w);
+  double xo = ellipse_form(o, s.s0, w), xi = ellipse_form(i, s.s0, w);
+  double yo = co * cr, yi = ci * cr;
+  double c_difference = (dot2(i.m, i.m) - dot2(o.m, o.m)) / (co + ci);  // |c_o| - |c_i|
+  double mi = dot2(i.m, s.s0) * dot2(i.m, w), mo = dot2(o.m, s.s0) * dot2(o.m, w);
+  // |c_o| x_i - |c_i| x_o, the factor of sin(alpha_o - alpha_i) besides cross(s0, w).
+  double mixed = -co * ci * c_difference * dot2(s.s0, w) + co * mi - ci * mo;
+  double alpha_o = std::atan2(yo, xo);
+  double alpha_difference = std::atan2(cr * mixed, xo * xi + yo * yi);
+  return 0.5 * (c_difference * alpha_o + ci * alpha_difference);
 }
 
 int ProjectedSolidAngleSampler::select_sector(double u0, double* area_in_sector) const {
@@ -358,9 +382,16 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
   // cancels, leaving ~1e-5 backward errors in double; the step form keeps full precision.
   double co2 = outer.c * outer.c, ci2 = inner.c * inner.c;
   double converged = 1e-13 * s.area;
+  double previous_residual = s.area;
   for (int iteration = 0; iteration < iterations_; ++iteration) {
+    // Past two iterations, a step only runs if the previous residual was large: convergence is
+    // cubic (Sec. 3.5), so from a residual below 1e-4 of the sector the step just taken left
+    // ~1e-12 (measured in projected_solid_angle_test.cpp). This keeps the third iteration's two
+    // arctangents for the ~1% of samples that need it.
+    if (iteration >= 2 && std::abs(previous_residual) <= 1e-6 * s.area) break;
     Vec2 wn = normalize2(w);
     double residual = area - area_up_to(s, wn);
+    previous_residual = residual;
     // Converged to rounding level: further steps would only move w by rounding noise.
     if (std::abs(residual) <= converged) break;
     if (residual > 0)
@@ -369,7 +400,10 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
       high = wn;
     Vec2 e = rotate90(wn);
     Vec2 p = apply_ellipse(outer, wn), q = apply_ellipse(inner, wn);
-    Vec2 g = sub2(scale2(q, co2), scale2(p, ci2));
+    // g = c_o^2 C_i w_n - c_i^2 C_o w_n; its c_o^2 c_i^2 w_n terms cancel exactly, so they are
+    // left out (they would swamp g for a sliver along the horizon, where g is tiny).
+    Vec2 g =
+        sub2(scale2(inner.m, co2 * dot2(inner.m, wn)), scale2(outer.m, ci2 * dot2(outer.m, wn)));
     double pw = dot2(p, wn), qw = dot2(q, wn), pe = dot2(p, e), qe = dot2(q, e);
     double a0 = -2.0 * residual * pw * qw;
     double a1 = dot2(g, wn) - 2.0 * residual * (pw * qe + pe * qw);
