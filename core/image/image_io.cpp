@@ -34,6 +34,10 @@ namespace {
 namespace oiio = OIIO;
 
 constexpr std::string_view kMetadataPrefix = "penumbra:";
+// Largest image read: the scene format's resolution limit per side, and far more channels than
+// the six we write.
+constexpr int kMaxImageSide = 16384;
+constexpr int kMaxChannels = 64;
 constexpr const char* kColorChannels[3] = {"R", "G", "B"};
 constexpr const char* kVarianceChannels[3] = {"variance.R", "variance.G", "variance.B"};
 
@@ -127,6 +131,13 @@ Image read_contents(oiio::ImageInput& input, const std::string& where, ImageMeta
   if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1)
     throw std::runtime_error(where + ": unsupported image size " + std::to_string(spec.width) +
                              "x" + std::to_string(spec.height) + "x" + std::to_string(spec.depth));
+  // A corrupt or hostile header must not make us allocate terabytes.
+  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || spec.nchannels > kMaxChannels)
+    throw std::runtime_error(where + ": image of " + std::to_string(spec.width) + "x" +
+                             std::to_string(spec.height) + " pixels and " +
+                             std::to_string(spec.nchannels) + " channels exceeds the limits (" +
+                             std::to_string(kMaxImageSide) + " per side, " +
+                             std::to_string(kMaxChannels) + " channels)");
 
   // Find the channels.
   int color_index[3], variance_index[3];

@@ -199,6 +199,34 @@ TEST(ExrMemory, TruncatedAndCorruptedExrThrows) {
   }
 }
 
+TEST(ExrMemory, HugeDimensionsInTheHeaderAreRefused) {
+  std::string bytes = encode_exr(random_image(4, 4, 18), nullptr, {});
+  // The header's window attributes: name, type "box2i", size 16, then xMin yMin xMax yMax
+  // (int32, little endian). Widen both windows, first past our limit of 16384 pixels per side
+  // (a valid header: OpenEXR accepts it, our check must refuse it), then to 2^30 (OpenEXR's own
+  // checks refuse it).
+  for (int32_t width : {20000, 1 << 30}) {
+    std::string widened = bytes;
+    for (const char* name : {"dataWindow", "displayWindow"}) {
+      std::string key = std::string(name) + std::string("\0box2i\0", 7);
+      size_t attribute = widened.find(key);
+      ASSERT_NE(attribute, std::string::npos) << name;
+      int32_t x_max = width - 1;
+      std::memcpy(&widened[attribute + key.size() + 4 + 8], &x_max, 4);
+    }
+    try {
+      decode_exr(widened);
+      ADD_FAILURE() << "decoded a " << width << " pixel wide image";
+    } catch (const std::runtime_error& error) {
+      std::string message = error.what();
+      EXPECT_NE(message.find("EXR bytes"), std::string::npos) << message;
+      if (width == 20000) {
+        EXPECT_NE(message.find("exceeds the limits"), std::string::npos) << message;
+      }
+    }
+  }
+}
+
 TEST(ExrFile, ErrorsNameThePath) {
   std::string missing = (test_directory() / "does-not-exist.exr").string();
   try {
