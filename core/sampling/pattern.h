@@ -41,6 +41,8 @@ void generate_1d(Pattern pattern, const StreamKey& key, std::span<double> out);
 // The N = out.size() 2D samples of a stream in [0,1)^2. `aspect` (>= 1 means wider than tall:
 // the light's long side over its short side, in the order of the two sample coordinates) shapes
 // the strata grid: a thin quad gets N x 1 strata along its length, a square sqrt(N) x sqrt(N).
+// The exact grid rule and what happens when N is not columns x rows: strata_grid() in strata.h;
+// what each pattern promises: the top of pattern.cpp (tests/core/sampling/ checks each promise).
 void generate_2d(Pattern pattern, const StreamKey& key, double aspect, std::span<Vec2> out);
 
 // Shirley-Chiu concentric map from [0,1)^2 to the unit disk (preserves stratification).

@@ -249,6 +249,27 @@ TEST(SobolPattern, FirstPointsUnscrambleToTheSobolSequence) {
   }
 }
 
+TEST(LowDiscrepancyPatterns, LargeCountsKeepTheirNets) {
+  // Beyond 2^16 (base 2) and 3^10 (base 3) points the patterns scramble point by point instead of
+  // through per-stream tables: the nets must survive the switch.
+  uint32_t n = uint32_t{1} << 17;
+  std::vector<Vec2> points(n);
+  generate_2d(Pattern::Sobol, {14, 0, 0, 0}, 1.0, points);
+  EXPECT_TRUE(is_base2_net(points, 17));
+  uint64_t strata3 = power(3, 11);
+  points.resize(strata3);
+  generate_2d(Pattern::Halton, {14, 1, 0, 0}, 1.0, points);
+  std::vector<int> count(strata3, 0);
+  for (const Vec2& p : points) ++count[stratum_of(p.y, strata3)];
+  for (int c : count) ASSERT_EQ(c, 1);
+  // The first 2^17 Halton points in x (base 2; 3^11 > 2^17).
+  points.resize(n);
+  generate_2d(Pattern::Halton, {14, 2, 0, 0}, 1.0, points);
+  count.assign(n, 0);
+  for (const Vec2& p : points) ++count[stratum_of(p.x, n)];
+  for (int c : count) ASSERT_EQ(c, 1);
+}
+
 TEST(SobolPattern, ScramblingChangesThePointsBetweenStreams) {
   // Without scrambling every stream would start at (0, 0).
   std::vector<double> first_x;
