@@ -69,14 +69,15 @@ struct SphericalRectangle {
     double z0_sq = r.z0 * r.z0;
     auto corner_length = [&](double x, double y) { return std::sqrt(x * x + y * y + z0_sq); };
     // (g0 and g1 enter only through S = g0 + g1 - k, computed more accurately below.)
-    double g2 = std::atan2(abs_z0 * corner_length(r.x0, r.y1), r.x0 * r.y1);
-    double g3 = std::atan2(abs_z0 * corner_length(r.x0, r.y0), -r.x0 * r.y0);
+    // k = 2 pi - g2 - g3, the two angles summed with one atan2 (a product of complex numbers).
+    double g2_plus_g3 = angle_sum(r.x0 * r.y1, abs_z0 * corner_length(r.x0, r.y1), -r.x0 * r.y0,
+                                  abs_z0 * corner_length(r.x0, r.y0));
     double n0_length_sq = z0_sq + r.y0 * r.y0;
     double n2_length_sq = z0_sq + r.y1 * r.y1;
     r.b0 = -r.y0 / std::sqrt(n0_length_sq);
     r.b1 = r.y1 / std::sqrt(n2_length_sq);
     r.z0_squared_over_n0_squared = z0_sq / n0_length_sq;
-    r.k = 2.0 * kPi - g2 - g3;
+    r.k = 2.0 * kPi - g2_plus_g3;
     r.solid_angle = r.solid_angle_up_to(r.x1);
     if (!(r.solid_angle > 0) || !std::isfinite(r.solid_angle)) return std::nullopt;
     return r;
@@ -95,7 +96,16 @@ struct SphericalRectangle {
         l00 * l10 * l11 + dot(v00, v10) * l11 + dot(v00, v11) * l10 + dot(v10, v11) * l00;
     double denominator_b =
         l00 * l11 * l01 + dot(v00, v11) * l01 + dot(v00, v01) * l11 + dot(v11, v01) * l00;
-    return 2.0 * (std::atan2(triple, denominator_a) + std::atan2(triple, denominator_b));
+    return 2.0 * angle_sum(denominator_a, triple, denominator_b, triple);
+  }
+
+  // arg(a) + arg(b) in [0, 2 pi) for complex numbers a = (re_a, im_a), b = (re_b, im_b) with
+  // im >= 0 (angles in [0, pi]): the argument of their product, one atan2 instead of two.
+  static double angle_sum(double re_a, double im_a, double re_b, double im_b) {
+    double re = difference_of_products(re_a, re_b, im_a, im_b);
+    double im = re_a * im_b + im_a * re_b;
+    double angle = std::atan2(im, re);
+    return angle < 0 ? angle + 2.0 * kPi : angle;
   }
 
   // Step 1: the x of the line chosen by u in [0,1] (Ureña et al. 2013 Sec. 4.2).

@@ -7,6 +7,7 @@
 // light sends it nothing) gets no sample, and the density is 0 there.
 
 #include <optional>
+#include <string_view>
 
 #include "core/strategies/strategy.h"
 
@@ -14,6 +15,9 @@ namespace penumbra {
 
 class AreaStrategy {
  public:
+  // The strategy's name in the method grammar (SCENE_FORMAT.md).
+  static constexpr std::string_view name() { return "area"; }
+
   AreaStrategy(const ShadingPoint& sp, const Light& light);
   std::optional<LightPoint> sample(const Vec2& u) const;
   // Area density at a point of the light (the point is assumed to lie on the light).

@@ -8,6 +8,7 @@
 // strategies agree on where the integrand is zero.
 
 #include <optional>
+#include <string_view>
 
 #include "core/strategies/strategy.h"
 
@@ -15,6 +16,9 @@ namespace penumbra {
 
 class BsdfStrategy {
  public:
+  // The strategy's name in the method grammar (SCENE_FORMAT.md).
+  static constexpr std::string_view name() { return "bsdf"; }
+
   BsdfStrategy(const ShadingPoint& sp, const Light& light);
   std::optional<LightPoint> sample(const Vec2& u) const;
   // Area density at a point of the light.

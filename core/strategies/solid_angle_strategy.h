@@ -19,6 +19,7 @@
 
 #include <array>
 #include <optional>
+#include <string_view>
 
 #include "core/math/spherical_rectangle.h"
 #include "core/strategies/strategy.h"
@@ -27,6 +28,9 @@ namespace penumbra {
 
 class SolidAngleStrategy {
  public:
+  // The strategy's name in the method grammar (SCENE_FORMAT.md).
+  static constexpr std::string_view name() { return "sa"; }
+
   SolidAngleStrategy(const ShadingPoint& sp, const Light& light);
   std::optional<LightPoint> sample(const Vec2& u) const;
   // Area density at a point of the light (the point is assumed to lie on the light).
