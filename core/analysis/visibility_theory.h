@@ -86,12 +86,14 @@ struct PredictedError {
 // The expected squared error of a pattern for k discontinuities placed as given over N strata,
 // when a closed form exists (see the .cpp for each derivation):
 //   DistinctStrata: uniform k/(12N^2), stratified k/(6N^2) (Figs. 4, 6), uniform jitter
-//     (k + (k mod 2))/(12N^2) (Fig. 6 and Sec. 4.2.2: each box 1/6, an odd one +1/12), the
-//     canonical Halton sequence at N = 2^m, and this renderer's Owen-scrambled Halton at N = 2^m
-//     (which is jittered stratified sampling there, so k/(6N^2)).
-//   Independent: random E[S(1-S)]/N (the variance of the step, 1/N); stratified as a sum over
-//     strata of E[f(1-f)]/N^2 (f a stratum's visible fraction); and, for k = 1 (one discontinuity
-//     is always alone in its stratum), the DistinctStrata forms.
+//     (k + (k mod 2))/(12N^2) (Fig. 6 and Sec. 4.2.2: each box 1/6, an odd one +1/12), stratum
+//     end-points (k/12 + [k odd]/4)/N^2 (1/(3N^2) for k = 1, Fig. 4), the canonical Halton
+//     sequence at N = 2^m, and this renderer's Owen-scrambled Halton at N = 2^m (which is
+//     jittered stratified sampling there, so as stratified).
+//   Independent: random E[S(1-S)]/N (the variance of the step, 1/N); stratified (and the
+//     renderer's Halton at N = 2^m) as a sum over strata of E[f(1-f)]/N^2 (f a stratum's visible
+//     fraction); and, for k = 1 (one discontinuity is always alone in its stratum), the
+//     DistinctStrata forms.
 //   Random with DistinctStrata has none (use Independent; its error does not see strata).
 std::optional<PredictedError> predicted_squared_error(VisibilityPattern pattern,
                                                       int discontinuities,
