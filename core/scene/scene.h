@@ -106,6 +106,9 @@ struct SceneLimits {
   int max_json_depth = 64;                  // nesting of JSON arrays and objects
 };
 
+// Related headers: scene_package.h (scene and OBJ bytes in memory, for the farm, and the content
+// hash's canonical form), light_setup.h (build lights with their derived fields in code).
+
 // Parses a scene from JSON text. `base_dir` resolves OBJ paths (which may not leave it).
 // `source` names the file in error messages. Throws FormatError.
 Scene parse_scene(const std::string& json_text, const std::string& base_dir,

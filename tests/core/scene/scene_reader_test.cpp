@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <string>
 
 #include "core/scene/scene.h"
@@ -364,6 +365,69 @@ TEST_F(FormatExample, TooManyTrianglesNamesTheLimit) {
                FormatError);
 }
 
+// Every JSON pointer to a leaf or member of `value`, for random edits.
+void collect_pointers(const json& value, const json::json_pointer& at,
+                      std::vector<json::json_pointer>& out) {
+  out.push_back(at);
+  if (value.is_object())
+    for (const auto& [key, member] : value.items()) collect_pointers(member, at / key, out);
+  if (value.is_array())
+    for (size_t i = 0; i < value.size(); ++i) collect_pointers(value[i], at / i, out);
+}
+
+TEST_F(FormatExample, RandomEditsEitherParseOrRaiseFormatError) {
+  // Robustness: thousands of random edits (bad values, wrong types, deleted keys) never crash
+  // the reader or escape as another exception, and whatever parses keeps the Scene invariants.
+  json base = json::parse(kFormatExample);
+  base["shapes"][2]["subdivisions"] = 1;  // keep each parse cheap
+  std::vector<json::json_pointer> pointers;
+  collect_pointers(base, json::json_pointer(), pointers);
+  const std::vector<json> replacements = {0,
+                                          -1,
+                                          1e-300,
+                                          1e300,
+                                          0.5,
+                                          3,
+                                          "x",
+                                          nullptr,
+                                          true,
+                                          json::array(),
+                                          json::object(),
+                                          json::array({1, 2, 3})};
+  std::mt19937 random(20261123);
+  int parsed = 0, refused = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    json edited = base;
+    for (int edit = 0; edit < 1 + trial % 3; ++edit) {
+      const json::json_pointer& target = pointers[random() % pointers.size()];
+      if (!edited.contains(target) || target.empty()) continue;
+      json& parent = edited[target.parent_pointer()];
+      if (random() % 4 == 0 && parent.is_object())
+        parent.erase(target.back());
+      else
+        edited[target] = replacements[random() % replacements.size()];
+    }
+    try {
+      Scene scene = parse_scene(edited.dump(), folder_.path().string(), "example.json");
+      ++parsed;
+      for (uint32_t index : scene.indices) ASSERT_LT(index, scene.positions.size());
+      for (const Vec3& p : scene.positions) ASSERT_TRUE(is_finite(p));
+      ASSERT_EQ(scene.triangle_materials.size(), scene.triangle_count());
+      for (const Light& light : scene.lights) {
+        ASSERT_TRUE(std::isfinite(light.area) && light.area > 0);
+        ASSERT_NEAR(length(light.normal), 1.0, 1e-12);
+        ASSERT_TRUE(is_finite(light.radiance));
+      }
+    } catch (const FormatError&) {
+      ++refused;
+    } catch (const std::exception& other) {
+      FAIL() << "trial " << trial << " escaped as " << other.what() << "\n" << edited.dump();
+    }
+  }
+  EXPECT_GT(parsed, 20);
+  EXPECT_GT(refused, 300);
+}
+
 TEST(SceneReader, RefusesBrokenJsonWithItsPosition) {
   try {
     parse_scene("{\"format\": \"penumbra/scene@1\", ", ".", "broken.json");
@@ -372,6 +436,15 @@ TEST(SceneReader, RefusesBrokenJsonWithItsPosition) {
     EXPECT_EQ(error.json_path(), "$");
     EXPECT_NE(std::string(error.what()).find("invalid JSON"), std::string::npos);
     EXPECT_NE(std::string(error.what()).find("broken.json"), std::string::npos);
+  }
+  // A number that overflows a double is refused as a whole document, naming the number.
+  try {
+    parse_scene(R"({"format": "penumbra/scene@1", "camera": {"fov_y_deg": 1e999}})", ".",
+                "overflow.json");
+    FAIL() << "accepted an overflowing number";
+  } catch (const FormatError& error) {
+    EXPECT_EQ(error.json_path(), "$");
+    EXPECT_NE(std::string(error.what()).find("1e999"), std::string::npos) << error.what();
   }
   EXPECT_THROW(parse_scene("[1, 2, 3]", ".", "array.json"), FormatError);
   EXPECT_THROW(parse_scene("", ".", "empty.json"), FormatError);
