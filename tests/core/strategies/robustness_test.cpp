@@ -86,6 +86,16 @@ void run_all(const ShadingPoint& sp, const Light& light, const std::string& wher
   double a = largest_estimate<AreaStrategy>(sp, light, where + " area");
   double s = largest_estimate<SolidAngleStrategy>(sp, light, where + " sa");
   double b = largest_estimate<BsdfStrategy>(sp, light, where + " bsdf");
+  if (!light_faces_point(light, sp.position)) {
+    // On the light's plane or behind it: no strategy can draw there, so every density is 0.
+    test::Rng rng(4);
+    for (int i = 0; i < 10; ++i) {
+      Vec3 p = light_point_uniform(light, rng.uniform2());
+      EXPECT_EQ(AreaStrategy(sp, light).pdf(p), 0.0) << where;
+      EXPECT_EQ(SolidAngleStrategy(sp, light).pdf(p), 0.0) << where;
+      EXPECT_EQ(BsdfStrategy(sp, light).pdf(p), 0.0) << where;
+    }
+  }
   if (light_sends_nothing) {
     EXPECT_EQ(a, 0.0) << where;
     EXPECT_EQ(s, 0.0) << where;
@@ -115,6 +125,8 @@ TEST(StrategyRobustness, DegenerateShadingPoints) {
         // Behind the light.
         run_all(sp(c - 0.5 * scale * down, {0, 1, 0}), light, name + " behind", true);
         run_all(sp(c - 1e-4 * scale * down, {0, -1, 0}), light, name + " just behind", true);
+        EXPECT_FALSE(light_faces_point(light, c - 1e-4 * scale * down));
+        EXPECT_FALSE(light_faces_point(light, c));
         // Just in front of it, under its centre and under a vertex/edge.
         for (double h : {1e-4, 1e-12}) {
           run_all(sp(c + h * scale * down, -down), light, name + " close", false);
