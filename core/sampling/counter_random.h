@@ -65,5 +65,7 @@ class StreamRandom {
 inline constexpr uint32_t kStreamDrawSample = 0xffffffffu;         // jitter offset, Owen seeds
 inline constexpr uint32_t kColumnPermutationSample = 0xfffffffeu;  // cmj shuffles
 inline constexpr uint32_t kRowPermutationSample = 0xfffffffdu;
+inline constexpr uint32_t kCellOrderSample = 0xfffffffcu;  // which stratum each sample visits
+inline constexpr uint32_t kBandOrderSample = 0xfffffffbu;
 
 }  // namespace penumbra

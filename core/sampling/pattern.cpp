@@ -18,6 +18,14 @@
 //                 multi-jittering has no second axis to correlate, so it is stratified.
 //
 // Halton and Sobol' ignore `aspect`: they are sequences, not grids.
+//
+// Sample order. In stratified, uniform-jitter and cmj, sample i visits a stratum chosen by a
+// random permutation per stream (cells and leftover bands separately: samples 0..cells()-1 are
+// still the grid's, the rest the bands'). So every sample index on its own is uniform over the
+// square, and sample i of one stream is independent of sample i of another: an estimator that
+// pairs them (pixel jitter i with light sample i) stays unbiased. Halton and Sobol' points are
+// each uniform already (Owen scrambling). The uniform pattern keeps its fixed order (no
+// randomness at all), so it pairs deterministically with other streams.
 
 #include "core/sampling/pattern.h"
 
@@ -62,20 +70,26 @@ class SmallBuffer {
 };
 
 // A uniformly random permutation of [0, size) (Fisher & Yates), drawn from the stream's
-// (sample, j) numbers.
+// (sample, j) numbers, 32 bits per swap; or the identity when not `shuffled`.
 class Permutation {
  public:
-  Permutation(const StreamRandom& rng, uint32_t sample, uint32_t size) : values_(size) {
+  Permutation(const StreamRandom& rng, uint32_t sample, uint32_t size, bool shuffled = true)
+      : shuffled_(shuffled), values_(shuffled ? size : 0) {
+    if (!shuffled) return;
     uint32_t* p = values_.data();
     for (uint32_t i = 0; i < size; ++i) p[i] = i;
+    uint64_t word = 0;
     for (uint32_t i = size; i > 1; --i) {
-      uint32_t j = bounded_index(rng.bits(sample, i - 1), i);
+      bool high_half = ((size - i) & 1u) == 0;
+      if (high_half) word = rng.bits(sample, i);
+      uint32_t j = bounded_index(high_half ? word : word << 32, i);
       std::swap(p[i - 1], p[j]);
     }
   }
-  uint32_t operator[](uint32_t i) const { return values_[i]; }
+  uint32_t operator[](uint32_t i) const { return shuffled_ ? values_[i] : i; }
 
  private:
+  bool shuffled_;
   SmallBuffer<uint32_t> values_;
 };
 
@@ -133,19 +147,24 @@ class ScrambledBase3Digits {
 };
 
 // Places the samples of a strata-grid pattern: `position_in_stratum(i)` gives sample i's relative
-// position (each coordinate in [0,1)) inside its cell or leftover band.
+// position (each coordinate in [0,1)) inside its cell or leftover band; `shuffled` picks a random
+// sample order (see "Sample order" above) over the fixed row-major one.
 template <typename PositionInStratum>
-void fill_strata_grid(const StrataGrid& grid, std::span<Vec2> out,
-                      PositionInStratum position_in_stratum) {
+void fill_strata_grid(const StreamRandom& rng, bool shuffled, const StrataGrid& grid,
+                      std::span<Vec2> out, PositionInStratum position_in_stratum) {
   uint32_t cells = grid.cells();
+  Permutation cell_order(rng, kCellOrderSample, cells, shuffled);
   for (uint32_t i = 0; i < cells; ++i) {
     Vec2 u = position_in_stratum(i);
-    out[i] = {point_in_stratum(i % grid.columns, grid.columns, u.x),
-              point_in_stratum(i / grid.columns, grid.rows, u.y)};
+    uint32_t cell = cell_order[i];
+    out[i] = {point_in_stratum(cell % grid.columns, grid.columns, u.x),
+              point_in_stratum(cell / grid.columns, grid.rows, u.y)};
   }
   // Leftovers: 1D strata along the long side, free across the short side.
-  for (uint32_t band = 0; band < grid.leftover; ++band) {
-    uint32_t i = cells + band;
+  Permutation band_order(rng, kBandOrderSample, grid.leftover, shuffled);
+  for (uint32_t j = 0; j < grid.leftover; ++j) {
+    uint32_t i = cells + j;
+    uint32_t band = band_order[j];
     Vec2 u = position_in_stratum(i);
     if (grid.leftover_along_x) {
       out[i] = {point_in_stratum(band, grid.leftover, u.x), u.y};
@@ -156,9 +175,10 @@ void fill_strata_grid(const StrataGrid& grid, std::span<Vec2> out,
 }
 
 // Kensler 2013, Sec. 3 (correlated multi-jittering) on an m x n grid: sample s sits in cell
-// (s % m, s / m); its x lies in thin stratum col * n + P_x[row] of the m n strata of [0,1), its y
-// in thin stratum row * m + P_y[col], where P_x shuffles [0,n) and P_y shuffles [0,m) once per
-// stream (the "correlated" part: every row shares one shuffle, every column one).
+// c = (s' % m, s' / m), s' the shuffled order of s (Kensler also permutes s); its x lies in thin
+// stratum col * n + P_x[row] of the m n strata of [0,1), its y in thin stratum row * m + P_y[col],
+// where P_x shuffles [0,n) and P_y shuffles [0,m) once per stream (the "correlated" part: every row
+// shares one shuffle, every column one).
 void correlated_multi_jittered(const StreamRandom& rng, const StrataGrid& grid,
                                std::span<Vec2> out) {
   uint32_t m = grid.columns;
@@ -166,14 +186,15 @@ void correlated_multi_jittered(const StreamRandom& rng, const StrataGrid& grid,
   uint32_t cells = grid.cells();
   Permutation x_substratum_of_row(rng, kRowPermutationSample, n);
   Permutation y_substratum_of_column(rng, kColumnPermutationSample, m);
+  Permutation cell_order(rng, kCellOrderSample, cells);
   for (uint32_t s = 0; s < cells; ++s) {
-    uint32_t column = s % m;
-    uint32_t row = s / m;
+    uint32_t column = cell_order[s] % m;
+    uint32_t row = cell_order[s] / m;
     out[s] = {point_in_stratum(column * n + x_substratum_of_row[row], cells, rng.uniform(s, 0)),
               point_in_stratum(row * m + y_substratum_of_column[column], cells, rng.uniform(s, 1))};
   }
-  fill_strata_grid(StrataGrid{0, 0, grid.leftover, grid.leftover_along_x}, out.subspan(cells),
-                   [&](uint32_t band) {
+  fill_strata_grid(rng, true, StrataGrid{0, 0, grid.leftover, grid.leftover_along_x},
+                   out.subspan(cells), [&](uint32_t band) {
                      uint32_t s = cells + band;
                      return Vec2(rng.uniform(s, 0), rng.uniform(s, 1));
                    });
@@ -223,15 +244,18 @@ void generate_1d(Pattern pattern, const StreamKey& key, std::span<double> out) {
       for (uint32_t i = 0; i < n; ++i) out[i] = rng.uniform(i, 0);
       return;
     case Pattern::Stratified:
-    case Pattern::Cmj:
-      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(i, n, rng.uniform(i, 0));
+    case Pattern::Cmj: {
+      Permutation order(rng, kCellOrderSample, n);
+      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(order[i], n, rng.uniform(i, 0));
       return;
+    }
     case Pattern::Uniform:
       for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(i, n, 0.5);
       return;
     case Pattern::UniformJitter: {
       double offset = rng.uniform(kStreamDrawSample, 0);
-      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(i, n, offset);
+      Permutation order(rng, kCellOrderSample, n);
+      for (uint32_t i = 0; i < n; ++i) out[i] = point_in_stratum(order[i], n, offset);
       return;
     }
     case Pattern::Halton:
@@ -255,15 +279,16 @@ void generate_2d(Pattern pattern, const StreamKey& key, double aspect, std::span
       for (uint32_t i = 0; i < n; ++i) out[i] = {rng.uniform(i, 0), rng.uniform(i, 1)};
       return;
     case Pattern::Stratified:
-      fill_strata_grid(strata_grid(n, aspect), out,
+      fill_strata_grid(rng, true, strata_grid(n, aspect), out,
                        [&](uint32_t i) { return Vec2(rng.uniform(i, 0), rng.uniform(i, 1)); });
       return;
     case Pattern::Uniform:
-      fill_strata_grid(strata_grid(n, aspect), out, [](uint32_t) { return Vec2(0.5, 0.5); });
+      fill_strata_grid(rng, false, strata_grid(n, aspect), out,
+                       [](uint32_t) { return Vec2(0.5, 0.5); });
       return;
     case Pattern::UniformJitter: {
       Vec2 offset(rng.uniform(kStreamDrawSample, 0), rng.uniform(kStreamDrawSample, 1));
-      fill_strata_grid(strata_grid(n, aspect), out, [&](uint32_t) { return offset; });
+      fill_strata_grid(rng, true, strata_grid(n, aspect), out, [&](uint32_t) { return offset; });
       return;
     }
     case Pattern::Halton: {

@@ -230,20 +230,29 @@ TEST(Patterns, UniformJitterSharesOneOffsetPerStream) {
       StrataGrid grid = strata_grid(n, aspect);
       for (uint64_t pixel = 0; pixel < 20; ++pixel) {
         std::vector<Vec2> points = points_2d(Pattern::UniformJitter, {6, pixel, 0, 2}, n, aspect);
-        // The position inside the cell is the same in every cell.
-        double offset_x = points[0].x * grid.columns;
-        double offset_y = points[0].y * grid.rows;
+        // The position inside the cell is the same in every cell (cells visited in any order).
+        auto offset_in_cell = [&](const Vec2& p) {
+          return Vec2(p.x * grid.columns - stratum_of(p.x, grid.columns),
+                      p.y * grid.rows - stratum_of(p.y, grid.rows));
+        };
+        Vec2 offset = offset_in_cell(points[0]);
         for (uint32_t i = 0; i < grid.cells(); ++i) {
-          EXPECT_NEAR(points[i].x * grid.columns - i % grid.columns, offset_x, 1e-12);
-          EXPECT_NEAR(points[i].y * grid.rows - i / grid.columns, offset_y, 1e-12);
+          EXPECT_NEAR(offset_in_cell(points[i]).x, offset.x, 1e-12);
+          EXPECT_NEAR(offset_in_cell(points[i]).y, offset.y, 1e-12);
+        }
+        // Leftover bands share it along their length too.
+        for (uint32_t i = grid.cells(); i < n; ++i) {
+          double along = grid.leftover_along_x ? points[i].x : points[i].y;
+          double shared = grid.leftover_along_x ? offset.x : offset.y;
+          EXPECT_NEAR(along * grid.leftover - stratum_of(along, grid.leftover), shared, 1e-12);
         }
       }
     }
     // 1D: (i + xi) / N with one xi, different between streams.
     std::vector<double> first = points_1d(Pattern::UniformJitter, {6, 0, 0, 0}, n);
     std::vector<double> second = points_1d(Pattern::UniformJitter, {6, 1, 0, 0}, n);
-    double xi = first[0] * n;
-    for (uint32_t i = 0; i < n; ++i) EXPECT_NEAR(first[i] * n - i, xi, 1e-12);
+    double xi = first[0] * n - stratum_of(first[0], n);
+    for (uint32_t i = 0; i < n; ++i) EXPECT_NEAR(first[i] * n - stratum_of(first[i], n), xi, 1e-12);
     EXPECT_NE(first[0], second[0]);
   }
 }
@@ -286,22 +295,49 @@ TEST(Patterns, MixtureOfSamplesIsUniform) {
   }
 }
 
-// The sample with one fixed index, across streams, must be uniform for the patterns whose points
-// are all individually uniform (random, halton, sobol: a scrambled net point is uniform).
-TEST(Patterns, EachScrambledPointIsUniform) {
+// Each sample index on its own, across streams, is uniform over the square for every randomized
+// pattern (grid patterns visit their strata in a random order per stream; a scrambled net point
+// is uniform): KS on both coordinates of samples 0, 5 and N - 1 (a leftover when N = 7).
+TEST(Patterns, EachSampleIndexIsUniform) {
   constexpr uint32_t kStreams = 20000;
-  for (Pattern pattern : {Pattern::Random, Pattern::Halton, Pattern::Sobol}) {
-    for (uint32_t index : {0u, 1u, 5u}) {
-      std::vector<double> xs, ys;
-      for (uint32_t stream = 0; stream < kStreams; ++stream) {
-        Vec2 p = points_2d(pattern, {13, stream, 0, 0}, 8, 1.0)[index];
-        xs.push_back(p.x);
-        ys.push_back(p.y);
+  for (Pattern pattern : kRandomizedPatterns) {
+    for (uint32_t n : {7u, 8u}) {
+      for (uint32_t index : {0u, 5u, n - 1}) {
+        std::vector<double> xs, ys, line;
+        for (uint32_t stream = 0; stream < kStreams; ++stream) {
+          Vec2 p = points_2d(pattern, {13, stream, 0, 0}, n, 1.0)[index];
+          xs.push_back(p.x);
+          ys.push_back(p.y);
+          line.push_back(points_1d(pattern, {13, stream, 0, 1}, n)[index]);
+        }
+        double critical = testing::ks_critical_0001(kStreams);
+        EXPECT_LT(testing::ks_statistic_uniform(xs), critical)
+            << name_of(pattern) << " n=" << n << " index " << index;
+        EXPECT_LT(testing::ks_statistic_uniform(ys), critical)
+            << name_of(pattern) << " n=" << n << " index " << index;
+        EXPECT_LT(testing::ks_statistic_uniform(line), critical)
+            << name_of(pattern) << " 1D n=" << n << " index " << index;
       }
-      EXPECT_LT(testing::ks_statistic_uniform(xs), testing::ks_critical_0001(kStreams))
-          << name_of(pattern) << " index " << index;
-      EXPECT_LT(testing::ks_statistic_uniform(ys), testing::ks_critical_0001(kStreams))
-          << name_of(pattern) << " index " << index;
+    }
+  }
+}
+
+// An estimator may pair sample i of one stream with sample i of another (pixel jitter with light
+// sample): the pair must be uniform on the product, or the estimate is biased. Chi-square on 4 x 4
+// bins of (x of 2D stream A, 1D stream B) at the same, randomly picked, index.
+TEST(Patterns, SameIndexSamplesOfTwoStreamsAreJointlyUniform) {
+  constexpr uint32_t kTrials = 20000;
+  for (Pattern pattern : kRandomizedPatterns) {
+    for (uint32_t n : {4u, 16u}) {
+      std::vector<uint64_t> bins(16, 0);
+      for (uint32_t trial = 0; trial < kTrials; ++trial) {
+        uint32_t pick = static_cast<uint32_t>(random_uniform({997, trial, 0, 0}, 0, 0) * n);
+        double a = points_2d(pattern, {14, trial, 0, 0}, n, 1.0)[pick].x;
+        double b = points_1d(pattern, {14, trial, 0, 1}, n)[pick];
+        ++bins[stratum_of(a, 4) * 4 + stratum_of(b, 4)];
+      }
+      EXPECT_LT(testing::chi_square_equal(bins), testing::chi_square_critical_0001(15))
+          << name_of(pattern) << " n=" << n;
     }
   }
 }
