@@ -8,7 +8,9 @@
 // The parametrization (u, v) -> point is uniform in solid angle:
 //   1. u picks the line x = xu (a line of the rectangle running along ey) so that the solid angle
 //      of the sub-rectangle [x0, xu] x [y0, y1] is u * S (the paper's Sec. 4.2, with
-//      au = u S + k and the closed form for cos(gamma_u)).
+//      au = u S + k and the closed form for cos(gamma_u)). cos(au) and sin(au) come from the
+//      angle-addition formulas with (cos k, sin k) kept instead of k: no atan2 for k, and u S
+//      keeps its relative precision for tiny rectangles instead of being added to k ~ pi.
 //   2. v is mapped to h in [h0, h1], h = y / sqrt(d^2 + y^2) with d = sqrt(xu^2 + z0^2) (the
 //      projection of the arc's endpoints onto the y axis), and h back to y (Sec. 4.3).
 //
@@ -35,8 +37,8 @@ struct SphericalRectangle {
   Vec3 corner;                  // the corner at local (x0, y0)
   Vec3 x_axis, y_axis, z_axis;  // unit; x along ex, y along ey, z such that z0 < 0
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0, z0 = 0;
-  double b0 = 0, b1 = 0;  // n0.z and n2.z of the paper
-  double k = 0;           // 2 pi - g2 - g3
+  double b0 = 0, b1 = 0;        // n0.z and n2.z of the paper
+  double cos_k = 1, sin_k = 0;  // k = 2 pi - g2 - g3
   double solid_angle = 0;
   double z0_squared_over_n0_squared = 0;  // 1 - b0^2, computed without cancellation
 
@@ -69,15 +71,20 @@ struct SphericalRectangle {
     double z0_sq = r.z0 * r.z0;
     auto corner_length = [&](double x, double y) { return std::sqrt(x * x + y * y + z0_sq); };
     // (g0 and g1 enter only through S = g0 + g1 - k, computed more accurately below.)
-    // k = 2 pi - g2 - g3, the two angles summed with one atan2 (a product of complex numbers).
-    double g2_plus_g3 = angle_sum(r.x0 * r.y1, abs_z0 * corner_length(r.x0, r.y1), -r.x0 * r.y0,
-                                  abs_z0 * corner_length(r.x0, r.y0));
+    // k = 2 pi - (g2 + g3): cos and sin of g2 + g3 from the product of the complex numbers
+    // whose arguments are g2 and g3.
+    double re2 = r.x0 * r.y1, im2 = abs_z0 * corner_length(r.x0, r.y1);
+    double re3 = -r.x0 * r.y0, im3 = abs_z0 * corner_length(r.x0, r.y0);
+    double re = difference_of_products(re2, re3, im2, im3), im = re2 * im3 + im2 * re3;
+    double modulus = std::sqrt(re * re + im * im);
+    if (!(modulus > 0)) return std::nullopt;
+    r.cos_k = re / modulus;
+    r.sin_k = -im / modulus;
     double n0_length_sq = z0_sq + r.y0 * r.y0;
     double n2_length_sq = z0_sq + r.y1 * r.y1;
     r.b0 = -r.y0 / std::sqrt(n0_length_sq);
     r.b1 = r.y1 / std::sqrt(n2_length_sq);
     r.z0_squared_over_n0_squared = z0_sq / n0_length_sq;
-    r.k = 2.0 * kPi - g2_plus_g3;
     r.solid_angle = r.solid_angle_up_to(r.x1);
     if (!(r.solid_angle > 0) || !std::isfinite(r.solid_angle)) return std::nullopt;
     return r;
@@ -110,12 +117,15 @@ struct SphericalRectangle {
 
   // Step 1: the x of the line chosen by u in [0,1] (Ureña et al. 2013 Sec. 4.2).
   double line_x(double u) const {
-    double au = u * solid_angle + k;
-    double sin_au = std::sin(au);
+    // au = u S + k by angle addition.
+    double partial = u * solid_angle;
+    double cos_partial = std::cos(partial), sin_partial = std::sin(partial);
+    double cos_au = cos_k * cos_partial - sin_k * sin_partial;
+    double sin_au = sin_k * cos_partial + cos_k * sin_partial;
     // fu = (cos(au) b0 - b1) / sin(au); cu = sign(fu) / sqrt(fu^2 + b0^2);
     // xu = -cu z0 / sqrt(1 - cu^2) = sign(fu) |z0| / sqrt(fu^2 - (1 - b0^2)).
     if (sin_au == 0) return std::clamp(0.0, x0, x1);  // fu infinite: cu = 0, xu = 0
-    double fu = (std::cos(au) * b0 - b1) / sin_au;
+    double fu = (cos_au * b0 - b1) / sin_au;
     double denominator = fu * fu - z0_squared_over_n0_squared;
     double xu;
     if (!(denominator > 0)) {
