@@ -216,16 +216,23 @@ class SceneParser {
     if (s.positions.size() + mesh.positions.size() > std::numeric_limits<uint32_t>::max())
       shape.fail("too many vertices for 32-bit indices");
     const auto base = static_cast<uint32_t>(s.positions.size());
+    size_t dropped = 0;
     s.positions.insert(s.positions.end(), mesh.positions.begin(), mesh.positions.end());
     for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
       const Vec3& a = mesh.positions[mesh.indices[t]];
       const Vec3& b = mesh.positions[mesh.indices[t + 1]];
       const Vec3& c = mesh.positions[mesh.indices[t + 2]];
-      if (length_squared(cross(b - a, c - a)) == 0) continue;
+      if (length_squared(cross(b - a, c - a)) == 0) {
+        ++dropped;
+        continue;
+      }
       s.indices.insert(s.indices.end(), {base + mesh.indices[t], base + mesh.indices[t + 1],
                                          base + mesh.indices[t + 2]});
       s.triangle_materials.push_back(material);
     }
+    if (dropped > 0)
+      s.warnings.push_back(shape.path() + ": dropped " + std::to_string(dropped) +
+                           " zero-area triangle(s)");
   }
 
   void parse_shapes(const JsonNode& node) {

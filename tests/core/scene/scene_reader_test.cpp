@@ -482,6 +482,22 @@ TEST(SceneReader, LoadSceneReportsUnreadableFile) {
   }
 }
 
+TEST(SceneReader, ZeroAreaTrianglesAreDroppedWithAWarning) {
+  TempDir folder;
+  std::string text = R"({
+    "format": "penumbra/scene@1",
+    "camera": { "position": [0,1,3], "look_at": [0,1,0], "fov_y_deg": 40, "width": 8, "height": 8 },
+    "materials": { "m": { "type": "lambert", "albedo": [0.5,0.5,0.5] } },
+    "shapes": [ { "type": "triangles", "positions": [[0,0,0],[1,0,0],[0,1,0],[2,0,0]],
+                  "indices": [0,1,2, 0,1,3, 2,2,1], "material": "m" } ],
+    "lights": [ { "type": "disk", "center": [0,5,0], "normal": [0,-1,0], "radius": 1, "radiance": [1,1,1] } ]
+  })";
+  Scene scene = parse_scene(text, folder.path().string(), "degenerate.json");
+  EXPECT_EQ(scene.triangle_count(), 1u);  // (0,1,3) is collinear, (2,2,1) repeats a vertex
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_NE(scene.warnings[0].find("$.shapes[0]: dropped 2"), std::string::npos);
+}
+
 TEST(SceneReader, CameraFieldsAndNonSquareImage) {
   TempDir folder;
   std::string text = R"({
