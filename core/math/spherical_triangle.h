@@ -38,15 +38,19 @@ struct SphericalTriangle {
 
   // Empty when the triangle is degenerate (zero solid angle).
   static std::optional<SphericalTriangle> prepare(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
-    SphericalTriangle t;
-    t.v0 = v0;
-    t.v1 = v1;
-    t.v2 = v2;
-    t.g0 = dot(v0, cross_accurate(v1, v2));
-    t.g1 = dot(v0, v2) + dot(v1, v2);
-    t.g2 = 1.0 + dot(v0, v1);
+    SphericalTriangle t = with_intermediates(v0, v1, v2);
     t.signed_area = 2.0 * std::atan2(t.g0, t.g1 + t.g2);
     if (!(std::abs(t.signed_area) > 0) || !std::isfinite(t.signed_area)) return std::nullopt;
+    return t;
+  }
+  // The same when the solid angle is already known (e.g. cached by a polygon's fan): skips the
+  // atan2 and takes the orientation from the sign of det(v0, v1, v2).
+  static std::optional<SphericalTriangle> prepare(const Vec3& v0, const Vec3& v1, const Vec3& v2,
+                                                  double known_solid_angle) {
+    SphericalTriangle t = with_intermediates(v0, v1, v2);
+    t.signed_area = std::copysign(known_solid_angle, t.g0);
+    if (!(known_solid_angle > 0) || !std::isfinite(known_solid_angle) || t.g0 == 0)
+      return std::nullopt;
     return t;
   }
 
@@ -76,6 +80,18 @@ struct SphericalTriangle {
     double tangent_length = length(tangent);
     if (!(tangent_length > 0)) return v1;
     return normalize(cos_theta * v1 + (sin_theta / tangent_length) * tangent);
+  }
+
+ private:
+  static SphericalTriangle with_intermediates(const Vec3& v0, const Vec3& v1, const Vec3& v2) {
+    SphericalTriangle t;
+    t.v0 = v0;
+    t.v1 = v1;
+    t.v2 = v2;
+    t.g0 = dot(v0, cross_accurate(v1, v2));
+    t.g1 = dot(v0, v2) + dot(v1, v2);
+    t.g2 = 1.0 + dot(v0, v1);
+    return t;
   }
 };
 

@@ -100,7 +100,7 @@ std::optional<LightPoint> SolidAngleStrategy::sample_fan(const Vec2& u) const {
   double u_in_triangle = std::clamp((target - chosen_begin) / chosen_omega, 0.0, 1.0);
   const std::vector<Vec3>& v = light_->vertices;
   auto triangle = SphericalTriangle::prepare(normalize(v[0] - x_), normalize(v[chosen + 1] - x_),
-                                             normalize(v[chosen + 2] - x_));
+                                             normalize(v[chosen + 2] - x_), chosen_omega);
   if (!triangle) return std::nullopt;
   Vec3 direction = triangle->sample({u_in_triangle, u.y});
   // The point where the direction meets the light's plane.

@@ -44,6 +44,11 @@ TEST(SphericalTriangle, SubtriangleHasTheRequestedSolidAngleAndSamplesStayInside
     ASSERT_TRUE(t.has_value());
     double area = t->solid_angle();
     EXPECT_LE(relative_difference(area, triangle_solid_angle(a, b, c)), 1e-9);
+    // Prepared with the solid angle known beforehand: the same map.
+    auto known = SphericalTriangle::prepare(a, b, c, triangle_solid_angle(a, b, c));
+    ASSERT_TRUE(known.has_value());
+    for (Vec2 xi : {Vec2{0.3, 0.6}, Vec2{0.9, 0.1}})
+      EXPECT_LE(length(known->sample(xi) - t->sample(xi)), 1e-9);
     for (double xi0 : {0.0, 0.1, 0.5, 0.9, 1.0}) {
       // xi1 = 1 gives the constructed vertex v2'; (v0, v1, v2') has solid angle xi0 * A.
       Vec3 v2_prime = t->sample({xi0, 1.0});
