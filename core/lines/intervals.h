@@ -54,8 +54,7 @@ class IntervalList {
     if (!(lo < hi) || size_ == 0) return;
     Interval* pieces = data();
     // First piece that ends after the cut starts (a piece ending exactly at lo is untouched).
-    size_t first = 0;
-    while (first < size_ && pieces[first].hi <= lo) ++first;
+    size_t first = first_ending_after(lo);
     // One past the last piece that starts before the cut ends.
     size_t last = first;
     while (last < size_ && pieces[last].lo < hi) ++last;
@@ -81,12 +80,8 @@ class IntervalList {
 
   // Would subtracting [lo, hi] change the list? (Some piece overlaps the open interval.)
   bool overlaps(double lo, double hi) const {
-    const Interval* pieces = data();
-    for (size_t i = 0; i < size_; ++i) {
-      if (pieces[i].hi <= lo) continue;
-      return pieces[i].lo < hi;
-    }
-    return false;
+    size_t first = first_ending_after(lo);
+    return first < size_ && data()[first].lo < hi;
   }
 
   bool fully_occluded() const { return size_ == 0; }
@@ -108,6 +103,27 @@ class IntervalList {
  private:
   Interval* data() { return heap_ ? heap_.get() : inline_; }
   const Interval* data() const { return heap_ ? heap_.get() : inline_; }
+
+  // Index of the first piece with hi > t (size_ when none): a linear scan for the few pieces
+  // of the common case, a binary search past that.
+  size_t first_ending_after(double t) const {
+    const Interval* pieces = data();
+    if (size_ <= 8) {
+      size_t i = 0;
+      while (i < size_ && pieces[i].hi <= t) ++i;
+      return i;
+    }
+    size_t lo = 0, hi = size_;
+    while (lo < hi) {
+      size_t mid = (lo + hi) / 2;
+      if (pieces[mid].hi <= t) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return lo;
+  }
 
   void grow(size_t needed) {
     size_t new_capacity = std::max(needed, 2 * capacity_);

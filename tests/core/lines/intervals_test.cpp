@@ -92,10 +92,15 @@ TEST(IntervalList, OverlapsMatchesWhetherSubtractChangesTheList) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int trial = 0; trial < 2000; ++trial) {
+    // Few pieces (linear scans) or many (binary searches).
     IntervalList list;
-    for (int i = 0; i < 6; ++i) {
-      double c = unit(rng), w = 0.1 * unit(rng);
+    int cut_count = trial % 2 ? 6 : 30;
+    for (int i = 0; i < cut_count; ++i) {
+      double c = unit(rng), w = (trial % 2 ? 0.1 : 0.01) * unit(rng);
       list.subtract(c - w, c + w);
+    }
+    if (trial % 2 == 0) {
+      EXPECT_GT(list.size(), 8u);
     }
     // Probe with random cuts and with cuts that end exactly on piece endpoints.
     std::vector<Interval> probes;
