@@ -5,7 +5,8 @@
 //                 strata_grid() cells plus its 1D-stratified leftovers (strata.h).
 // uniform         the centre of each of those strata: no randomness at all.
 // uniform-jitter  the uniform pattern shifted by one random offset per stream, the same offset in
-//                 every stratum (Ramamoorthi et al. 2012, Sec. 4.2.2): 1D (i + xi) / N.
+//                 every stratum (Ramamoorthi et al. 2012, Sec. 4.2.2): 1D (k + xi) / N for the
+//                 N strata k.
 // halton          radical inverses in bases 2 (x) and 3 (y) of indices 0..N-1, Owen scrambled
 //                 per stream (low_discrepancy.h). The first 2^a 3^b points put one point in each
 //                 box [i/2^a, (i+1)/2^a) x [j/3^b, (j+1)/3^b). 1D: base 2.
@@ -200,8 +201,9 @@ void correlated_multi_jittered(const StreamRandom& rng, const StrataGrid& grid,
                    });
 }
 
-// Owen-scrambled base-2 coordinate of point `index`: `unscrambled` holds its digits as a 0.32
-// fraction, of which the first `levels` separate the stream's points (low_discrepancy.h).
+// Owen-scrambled base-2 coordinate of point `index`: `scrambled_digits` holds its first `levels`
+// scrambled digits (a 0.32 fraction); the digits below are the point's own random bits
+// (low_discrepancy.h).
 inline double scrambled_base2(const StreamRandom& rng, uint32_t index, uint32_t dimension,
                               uint32_t scrambled_digits, int levels) {
   return fraction_from_base2_digits(scrambled_digits, levels, rng.bits(index, dimension));
