@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <xmmintrin.h>
 
+#include <atomic>
 #include <cfloat>
 #include <cmath>
 #include <limits>
@@ -54,10 +55,19 @@ void set_bounds(void* node, const RTCBounds** bounds, unsigned int child_count, 
   for (unsigned i = 0; i < child_count; ++i) inner->bounds[i] = *bounds[i];
 }
 
+// Set from Embree's build threads when a leaf is larger than asked (Embree promises not to).
+struct BuildStatus {
+  std::atomic<bool> oversized_leaf{false};
+};
+
 void* create_leaf(RTCThreadLocalAllocator allocator, const RTCBuildPrimitive* primitives,
-                  size_t primitive_count, void*) {
+                  size_t primitive_count, void* user) {
   void* memory = rtcThreadLocalAlloc(allocator, sizeof(BuildLeaf), 16);
   auto* leaf = new (memory) BuildLeaf();
+  if (primitive_count > RTC_BUILD_MAX_PRIMITIVES_PER_LEAF) {
+    static_cast<BuildStatus*>(user)->oversized_leaf = true;
+    primitive_count = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF;
+  }
   leaf->triangle_count = static_cast<unsigned>(primitive_count);
   for (size_t i = 0; i < primitive_count; ++i) leaf->triangles[i] = primitives[i].primID;
   return leaf;
@@ -216,7 +226,8 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   arguments.createLeaf = create_leaf;
   arguments.splitPrimitive = nullptr;  // no spatial splits
   arguments.buildProgress = nullptr;
-  arguments.userPtr = nullptr;
+  BuildStatus status;
+  arguments.userPtr = &status;
   auto* root = static_cast<BuildNode*>(rtcBuildBVH(&arguments));
   if (!root) {
     rtcReleaseBVH(bvh);
@@ -259,13 +270,17 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     }
     node.child[slot] = code;
   };
-  // Returns the code of the flattened subtree.
-  auto flatten = [&](auto&& self, const BuildNode* node) -> uint32_t {
+  // Returns the code of the flattened subtree. The traversal stack holds at most 3 entries per
+  // level plus 4, so the depth is bounded (Embree's maxDepth is 32; checked anyway).
+  const int max_depth = (kStackCapacity - 4) / 3;
+  auto flatten = [&](auto&& self, const BuildNode* node, int depth) -> uint32_t {
     if (node->is_leaf) return flatten_leaf(reinterpret_cast<const BuildLeaf*>(node));
+    if (depth > max_depth)
+      throw std::runtime_error("LineQuery: BVH deeper than " + std::to_string(max_depth));
     auto* inner = reinterpret_cast<const BuildInner*>(node);
     uint32_t index = new_node();
     for (unsigned i = 0; i < inner->child_count; ++i) {
-      uint32_t code = self(self, inner->children[i]);
+      uint32_t code = self(self, inner->children[i], depth + 1);
       set_slot(index, static_cast<int>(i), inner->bounds[i], code);
     }
     return index;
@@ -285,10 +300,19 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     }
     set_slot(index, 0, bounds, flatten_leaf(reinterpret_cast<const BuildLeaf*>(root)));
   } else {
-    flatten(flatten, root);
+    try {
+      flatten(flatten, root, 1);
+    } catch (...) {
+      rtcReleaseBVH(bvh);
+      rtcReleaseDevice(device);
+      throw;
+    }
   }
   rtcReleaseBVH(bvh);
   rtcReleaseDevice(device);
+  if (status.oversized_leaf)
+    throw std::runtime_error("LineQuery: Embree made a leaf larger than " +
+                             std::to_string(RTC_BUILD_MAX_PRIMITIVES_PER_LEAF) + " triangles");
 }
 
 void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, IntervalList& out,

@@ -471,6 +471,23 @@ TEST(LineQuery, DegenerateInputsGiveFiniteAnswers) {
   EXPECT_EQ(query(empty, {0, 0, 0}, {0, 2, 0}, {1, 2, 0}).visible_length(), 1.0);
 }
 
+TEST(LineQuery, ManyCoincidentTrianglesBuildAndQuery) {
+  // 5000 copies of one triangle (no split helps the builder) plus copies of a quad: the tree
+  // stays within the traversal's bounds and the answer matches the brute force.
+  TriangleMesh mesh;
+  mesh.positions = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0, 1, 0.5}};
+  for (int i = 0; i < 5000; ++i) mesh.add_triangle(0, 1, 2);
+  for (int i = 0; i < 100; ++i) mesh.append(quad({-2, 1.5, -2}, {1, 0, 0}, {0, 0, 1}));
+  LineQuery line_query(mesh.positions, mesh.indices);
+  EXPECT_EQ(line_query.triangle_count(), 5200u);
+  Random random(91);
+  for (int trial = 0; trial < 50; ++trial) {
+    Vec3 x = random.in_box({-1, -1, -1}, {1, 0, 1});
+    Vec3 a = random.in_box({-2, 2, -2}, {2, 2.5, 2}), b = random.in_box({-2, 2, -2}, {2, 2.5, 2});
+    expect_same_intervals(query(line_query, x, a, b), brute_force(mesh, x, a, b), "coincident");
+  }
+}
+
 TEST(LineQuery, ScalingTheSceneByPowersOfTwoGivesTheSameBits) {
   TriangleMesh mesh = random_triangles_mesh(1000, {-1, -1, -1}, {1, 1, 1}, 0.1, 61);
   LineQuery unit_query(mesh.positions, mesh.indices);
