@@ -1,15 +1,15 @@
 // penumbra-coordinator: serves the farm's jobs and workers APIs.
 //   penumbra-coordinator --listen 0.0.0.0:7420 --data-dir /var/lib/penumbra
-#include <pthread.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
-#include <csignal>
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <thread>
 
 #include "proto/support/scene_packing.h"
+#include "proto/support/shutdown_signals.h"
 #include "server/coordinator_server.h"
 
 int main(int argc, char** argv) {
@@ -35,16 +35,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_level(spdlog::level::from_str(log_level));
+  spdlog::flush_on(spdlog::level::info);
   options.data_dir = data_dir;
   options.lease_time = std::chrono::milliseconds(int64_t(lease_seconds * 1000));
   options.max_scene_bytes = max_scene_mib << 20;
 
-  // SIGINT and SIGTERM are taken by a thread that shuts the server down.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // SIGINT and SIGTERM shut the server down (polled by a thread; the handler only counts).
+  penumbra::farm::install_shutdown_signals();
 
   try {
     penumbra::farm::Coordinator coordinator(options, penumbra::farm::parse_wire_package);
@@ -56,14 +53,17 @@ int main(int argc, char** argv) {
       std::ofstream(temporary) << server.port() << "\n";
       std::rename(temporary.c_str(), port_file.c_str());
     }
-    std::thread signal_thread([&] {
-      int signal = 0;
-      sigwait(&signals, &signal);
-      spdlog::info("signal {}: shutting down", signal);
+    std::atomic<bool> stopped{false};
+    std::thread signal_watch([&] {
+      while (penumbra::farm::shutdown_signal_count() == 0 && !stopped)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (stopped) return;
+      spdlog::info("signal: shutting down");
       server.shutdown();
     });
     server.wait();
-    signal_thread.join();
+    stopped = true;
+    signal_watch.join();
   } catch (const std::exception& error) {
     spdlog::critical("{}", error.what());
     return 1;

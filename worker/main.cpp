@@ -1,13 +1,12 @@
 // penumbra-worker: renders tasks for a Penumbra coordinator.
 //   penumbra-worker --coordinator host:7420 --threads 8 --cache-dir ~/.cache/penumbra
-#include <pthread.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <csignal>
 #include <thread>
 
+#include "proto/support/shutdown_signals.h"
 #include "worker/worker.h"
 
 int main(int argc, char** argv) {
@@ -27,26 +26,21 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
+  spdlog::flush_on(spdlog::level::info);
 
   // SIGTERM/SIGINT: drain (finish and deliver the tasks held); a second one exits at once.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-
+  penumbra::farm::install_shutdown_signals();
   penumbra::farm::RenderWorker worker(options);
-  std::thread signal_thread([&] {
-    int signal = 0;
-    sigwait(&signals, &signal);
-    if (signal == 0) return;
-    spdlog::info("signal {}: draining", signal);
+  std::thread signal_watch([&worker] {
+    while (penumbra::farm::shutdown_signal_count() == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    spdlog::info("signal: draining");
     worker.drain();
-    sigwait(&signals, &signal);
-    if (signal == 0) return;
+    while (penumbra::farm::shutdown_signal_count() < 2)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
     spdlog::warn("second signal: exiting without draining");
     std::_Exit(1);
   });
-  signal_thread.detach();
+  signal_watch.detach();
   return worker.run();
 }

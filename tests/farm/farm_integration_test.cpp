@@ -1,44 +1,21 @@
-// The farm end to end on loopback with real processes: penumbra-coordinator and penumbra-worker
-// binaries, a client through the jobs API. Every finished image is compared bit for bit with a
-// render of the same job in this process (Renderer + assemble_film, other tiles and pass ranges).
-#include <grpcpp/generic/generic_stub.h>
+// The farm end to end: coordinator and worker processes on loopback, images bit-identical to
+// a local render, concurrent jobs, error curves against a reference job.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+
+#include "core/image/metrics.h"
 #include "farm_test_support.h"
+#include "penumbra/version.h"
 
 namespace penumbra::farm {
 namespace {
 
 using namespace std::chrono_literals;
-using testing::ChildProcess;
 using testing::CoordinatorProcess;
-
-void expect_bit_identical(FarmClient& client, const std::string& job_id,
-                          const std::string& scene_path, const std::string& method, uint32_t spp,
-                          uint64_t seed) {
-  ImageMetadata metadata;
-  Image variance;
-  Image color = decode_exr(client.fetch(job_id), &metadata, &variance);
-  Film local = testing::render_locally(scene_path, method, "stratified", spp, seed);
-  EXPECT_TRUE(testing::same_bits(color, local.color)) << job_id << ": color differs";
-  EXPECT_TRUE(testing::same_bits(variance, local.variance)) << job_id << ": variance differs";
-  EXPECT_EQ(metadata["penumbra:spp"], std::to_string(spp));
-  EXPECT_EQ(metadata["penumbra:method"], method);
-}
-
-v1::JobStatus wait_until(FarmClient& client, const std::string& job_id,
-                         const std::function<bool(const v1::JobStatus&)>& condition,
-                         std::chrono::milliseconds timeout = 60s) {
-  auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (true) {
-    v1::JobStatus status = client.status(job_id);
-    if (condition(status)) return status;
-    if (std::chrono::steady_clock::now() > deadline)
-      throw std::runtime_error(job_id + ": condition not reached in time; state " +
-                               v1::JobState_Name(status.state()));
-    std::this_thread::sleep_for(10ms);
-  }
-}
+using testing::expect_bit_identical;
 
 TEST(FarmIntegration, TwoWorkersRenderBitIdenticalToLocal) {
   auto dir = testing::fresh_directory("two-workers");
@@ -66,6 +43,61 @@ TEST(FarmIntegration, TwoWorkersRenderBitIdenticalToLocal) {
   uint64_t completed = 0;
   for (const auto& worker : workers) completed += worker.tasks_completed();
   EXPECT_EQ(completed, 48u);
+}
+
+TEST(FarmIntegration, ConcurrentJobsAllCompleteBitIdentical) {
+  auto dir = testing::fresh_directory("concurrent");
+  std::string scene = testing::write_scene(dir, 64, 48);
+  CoordinatorProcess coordinator(dir / "data");
+  auto worker_a = testing::start_worker(coordinator.address(), dir, "a");
+  auto worker_b = testing::start_worker(coordinator.address(), dir, "b");
+  struct Submitted {
+    std::string job, method;
+    uint32_t spp;
+    uint64_t seed;
+  };
+  std::vector<Submitted> jobs = {{"", "sa", 16, 1}, {"", "area", 12, 2}, {"", "sa", 20, 3}};
+  FarmClient client(coordinator.address());
+  for (Submitted& job : jobs)
+    job.job =
+        client.submit(testing::job_spec(scene, job.method, job.spp, job.seed, 16, 3)).job_id();
+  for (const Submitted& job : jobs) {
+    v1::JobStatus status = client.wait(job.job, 60s);
+    ASSERT_EQ(status.state(), v1::JOB_STATE_DONE) << job.job << ": " << status.error();
+    expect_bit_identical(client, job.job, scene, job.method, job.spp, job.seed);
+  }
+  EXPECT_EQ(client.list().size(), 3u);
+}
+
+TEST(FarmIntegration, ReferenceJobGivesErrorCurveAndRegionErrors) {
+  auto dir = testing::fresh_directory("reference");
+  std::string scene = testing::write_scene(dir, 64, 48);
+  CoordinatorProcess coordinator(dir / "data");
+  auto worker = testing::start_worker(coordinator.address(), dir, "w", 2);
+  FarmClient client(coordinator.address());
+  std::string reference = client.submit(testing::job_spec(scene, "sa", 64, 100)).job_id();
+  ASSERT_EQ(client.wait(reference, 60s).state(), v1::JOB_STATE_DONE);
+  v1::JobSpec spec = testing::job_spec(scene, "sa", 16, 1);
+  spec.set_reference_job(reference);
+  std::string job = client.submit(spec).job_id();
+  ASSERT_EQ(client.wait(job, 60s).state(), v1::JOB_STATE_DONE);
+  v1::JobStatus status = client.status(job);
+  ASSERT_EQ(status.curve_size(), 4);  // one point per sealed block of 4 passes
+  for (int i = 0; i < status.curve_size(); ++i) {
+    EXPECT_EQ(status.curve(i).passes(), uint32_t(4 * (i + 1)));
+    EXPECT_TRUE(std::isfinite(status.curve(i).mrse()));
+    EXPECT_GT(status.curve(i).mrse(), 0.0);
+  }
+  EXPECT_LT(status.curve(3).mrse(), status.curve(0).mrse()) << "error should fall with passes";
+  ASSERT_EQ(status.errors_size(), 2);  // "image" and the scene's one region
+  // The final MRSE equals core's metric on the two images.
+  Image test = decode_exr(client.fetch(job));
+  Image ref = decode_exr(client.fetch(reference));
+  for (const auto& error : status.errors())
+    if (error.region() == "image") {
+      EXPECT_DOUBLE_EQ(error.mrse(), mrse(test, ref));
+    }
+  EXPECT_DOUBLE_EQ(status.mrse(), status.curve(3).mrse());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // a small scene written to a temporary folder, and a local render to compare against.
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -215,6 +217,33 @@ inline std::unique_ptr<ChildProcess> start_worker(const std::string& address,
                                "--threads", std::to_string(threads), "--cache-dir",
                                (dir / ("cache-" + name)).string(), "--name", name},
       (dir / (name + ".log")).string());
+}
+
+inline void expect_bit_identical(FarmClient& client, const std::string& job_id,
+                                 const std::string& scene_path, const std::string& method,
+                                 uint32_t spp, uint64_t seed) {
+  ImageMetadata metadata;
+  Image variance;
+  Image color = decode_exr(client.fetch(job_id), &metadata, &variance);
+  Film local = render_locally(scene_path, method, "stratified", spp, seed);
+  EXPECT_TRUE(same_bits(color, local.color)) << job_id << ": color differs";
+  EXPECT_TRUE(same_bits(variance, local.variance)) << job_id << ": variance differs";
+  EXPECT_EQ(metadata["penumbra:spp"], std::to_string(spp));
+  EXPECT_EQ(metadata["penumbra:method"], method);
+}
+
+inline v1::JobStatus wait_until(FarmClient& client, const std::string& job_id,
+                                const std::function<bool(const v1::JobStatus&)>& condition,
+                                std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    v1::JobStatus status = client.status(job_id);
+    if (condition(status)) return status;
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error(job_id + ": condition not reached in time; state " +
+                               v1::JobState_Name(status.state()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
 }
 
 }  // namespace penumbra::farm::testing

@@ -1,0 +1,266 @@
+// The coordinator's core without gRPC or a renderer: fake workers lease tasks and complete them
+// with synthetic tiles whose values depend on pixel and pass, so the assembled image is known.
+#include "server/coordinator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <thread>
+
+#include "farm_test_support.h"
+#include "penumbra/version.h"
+#include "proto/support/scene_packing.h"
+
+namespace penumbra::farm {
+namespace {
+
+using namespace std::chrono_literals;
+
+// The radiance a fake worker "renders" for pixel (x, y) in pass p (exactly representable).
+Rgb fake_radiance(int x, int y, uint32_t pass) {
+  return {double(x % 7) * 0.25 + pass * 0.5, double(y % 5) * 0.125, double((x + y + pass) % 3)};
+}
+
+TileAccumulator fake_render(const v1::Task& task) {
+  TileRect rect{task.tile().x0(), task.tile().y0(), task.tile().x1(), task.tile().y1()};
+  TileAccumulator tile(rect);
+  for (int y = rect.y0; y < rect.y1; ++y)
+    for (int x = rect.x0; x < rect.x1; ++x)
+      for (uint32_t pass = task.pass_begin(); pass < task.pass_end(); ++pass)
+        tile.add_sample(int64_t(y - rect.y0) * rect.width() + (x - rect.x0),
+                        fake_radiance(x, y, pass));
+  return tile;
+}
+
+Film expected_film(int width, int height, uint32_t spp) {
+  std::vector<TileAccumulator> tiles;
+  TileRect rect{0, 0, width, height};
+  tiles.emplace_back(rect);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (uint32_t pass = 0; pass < spp; ++pass)
+        tiles.back().add_sample(int64_t(y) * width + x, fake_radiance(x, y, pass));
+  return assemble_film(width, height, tiles);
+}
+
+class CoordinatorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::fresh_directory("coordinator-unit");
+    scene_path_ = testing::write_scene(dir_, 40, 24);
+    options_.data_dir = (dir_ / "data").string();
+    options_.lease_time = 200ms;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::unique_ptr<Coordinator> make() {
+    return std::make_unique<Coordinator>(options_, parse_wire_package);
+  }
+  std::string register_worker(Coordinator& coordinator, const std::string& name) {
+    v1::RegisterRequest request;
+    request.set_name(name);
+    request.set_threads(1);
+    request.set_build_flavour(kBuildFlavour);
+    request.set_protocol_version(v1::PROTOCOL_VERSION_CURRENT);
+    return coordinator.register_worker(request).worker_id();
+  }
+  std::vector<v1::Task> lease(Coordinator& coordinator, const std::string& worker, uint32_t n) {
+    v1::LeaseTasksRequest request;
+    request.set_worker_id(worker);
+    request.set_max_tasks(n);
+    auto response = coordinator.lease_tasks(request);
+    return {response.tasks().begin(), response.tasks().end()};
+  }
+  bool complete(Coordinator& coordinator, const std::string& worker, const v1::Task& task,
+                double seconds = 0.01) {
+    v1::CompleteTaskRequest request;
+    request.set_worker_id(worker);
+    request.set_job_id(task.job_id());
+    request.set_task_index(task.task_index());
+    request.set_attempt_token(task.attempt_token());
+    request.set_tile(fake_render(task).serialize());
+    request.set_compute_seconds(seconds);
+    return coordinator.complete_task(request);
+  }
+  v1::JobSpec spec(uint32_t spp) {
+    // tiles of 16: 40x24 -> 3 x 2 = 6 tiles; 4 passes per task.
+    return testing::job_spec(scene_path_, "sa", spp, 1, 16, 4);
+  }
+
+  std::filesystem::path dir_;
+  std::string scene_path_;
+  CoordinatorOptions options_;
+};
+
+TEST_F(CoordinatorTest, CompletionsInAnyOrderAssembleTheExactImage) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "fake");
+  std::string job = coordinator->submit(spec(10)).job_id();  // blocks of 4, 4, 2 passes
+  std::vector<v1::Task> tasks = lease(*coordinator, worker, 100);
+  ASSERT_EQ(tasks.size(), 18u);
+  EXPECT_EQ(tasks.back().pass_begin(), 8u);
+  EXPECT_EQ(tasks.back().pass_end(), 10u);
+  // Complete in reverse order: blocks seal only once every tile has finished them.
+  for (auto it = tasks.rbegin(); it != tasks.rend(); ++it) {
+    EXPECT_EQ(coordinator->status(job).passes_complete(), 0u);
+    EXPECT_TRUE(complete(*coordinator, worker, *it));
+    if (it->task_index() == 0) break;
+  }
+  v1::JobStatus status = coordinator->status(job);
+  EXPECT_EQ(status.state(), v1::JOB_STATE_DONE);
+  EXPECT_EQ(status.passes_complete(), 10u);
+  EXPECT_NEAR(status.compute_seconds(), 0.18, 1e-9);
+  Film film = coordinator->result_film(job);
+  Film expected = expected_film(40, 24, 10);
+  EXPECT_TRUE(testing::same_bits(film.color, expected.color));
+  EXPECT_TRUE(testing::same_bits(film.variance, expected.variance));
+}
+
+TEST_F(CoordinatorTest, ExpiredLeaseIsRequeuedAndItsLateResultDropped) {
+  auto coordinator = make();
+  std::string slow = register_worker(*coordinator, "slow");
+  std::string fast = register_worker(*coordinator, "fast");
+  std::string job = coordinator->submit(spec(4)).job_id();
+  std::vector<v1::Task> held = lease(*coordinator, slow, 1);
+  ASSERT_EQ(held.size(), 1u);
+  // The slow worker neither heartbeats nor completes: after the lease time its task is queued
+  // again (the coordinator's expiry thread runs every lease_time / 4).
+  std::this_thread::sleep_for(400ms);
+  std::vector<v1::Task> rest = lease(*coordinator, fast, 100);
+  ASSERT_EQ(rest.size(), 6u);
+  EXPECT_EQ(rest.front().task_index(), held[0].task_index()) << "requeued tasks go first";
+  EXPECT_NE(rest.front().attempt_token(), held[0].attempt_token());
+  EXPECT_FALSE(complete(*coordinator, slow, held[0])) << "a late result must be dropped";
+  for (const v1::Task& task : rest) EXPECT_TRUE(complete(*coordinator, fast, task));
+  EXPECT_FALSE(complete(*coordinator, fast, rest[0])) << "a duplicate must be dropped";
+  EXPECT_EQ(coordinator->status(job).state(), v1::JOB_STATE_DONE);
+  EXPECT_TRUE(
+      testing::same_bits(coordinator->result_film(job).color, expected_film(40, 24, 4).color));
+}
+
+TEST_F(CoordinatorTest, HeartbeatsKeepLeasesAndReportRevokedOnes) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "w");
+  std::string job = coordinator->submit(spec(4)).job_id();
+  std::vector<v1::Task> held = lease(*coordinator, worker, 2);
+  for (int i = 0; i < 6; ++i) {
+    std::this_thread::sleep_for(60ms);
+    v1::HeartbeatRequest heartbeat;
+    heartbeat.set_worker_id(worker);
+    heartbeat.add_attempt_tokens(held[0].attempt_token());
+    EXPECT_EQ(coordinator->heartbeat(heartbeat).revoked_tokens_size(), 0);
+  }
+  // 360 ms without a heartbeat for the second task: revoked. The first one is still valid.
+  v1::HeartbeatRequest heartbeat;
+  heartbeat.set_worker_id(worker);
+  heartbeat.add_attempt_tokens(held[0].attempt_token());
+  heartbeat.add_attempt_tokens(held[1].attempt_token());
+  auto response = coordinator->heartbeat(heartbeat);
+  ASSERT_EQ(response.revoked_tokens_size(), 1);
+  EXPECT_EQ(response.revoked_tokens(0), held[1].attempt_token());
+  EXPECT_TRUE(complete(*coordinator, worker, held[0]));
+  coordinator->cancel(job);
+  EXPECT_EQ(coordinator->heartbeat(heartbeat).revoked_tokens_size(), 2);
+}
+
+TEST_F(CoordinatorTest, ATaskFailingThreeTimesFailsTheJobWithTheWorkersError) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "w");
+  std::string job = coordinator->submit(spec(4)).job_id();
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    std::vector<v1::Task> tasks = lease(*coordinator, worker, 1);
+    ASSERT_EQ(tasks.size(), 1u);
+    EXPECT_EQ(tasks[0].task_index(), 0u);
+    v1::FailTaskRequest failure;
+    failure.set_worker_id(worker);
+    failure.set_job_id(tasks[0].job_id());
+    failure.set_task_index(tasks[0].task_index());
+    failure.set_attempt_token(tasks[0].attempt_token());
+    failure.set_error("out of cheese");
+    coordinator->fail_task(failure);
+  }
+  v1::JobStatus status = coordinator->status(job);
+  EXPECT_EQ(status.state(), v1::JOB_STATE_FAILED);
+  EXPECT_NE(status.error().find("out of cheese"), std::string::npos) << status.error();
+  EXPECT_TRUE(lease(*coordinator, worker, 10).empty());
+  EXPECT_THROW(coordinator->result_exr(job), FarmError);
+}
+
+TEST_F(CoordinatorTest, RestartKeepsSealedBlocksAndCompletedTasks) {
+  std::string job;
+  std::string token_before_restart;
+  {
+    auto coordinator = make();
+    std::string worker = register_worker(*coordinator, "w");
+    job = coordinator->submit(spec(12)).job_id();
+    std::vector<v1::Task> tasks = lease(*coordinator, worker, 100);
+    ASSERT_EQ(tasks.size(), 18u);
+    for (size_t i = 0; i < 8; ++i) EXPECT_TRUE(complete(*coordinator, worker, tasks[i]));
+    EXPECT_EQ(coordinator->status(job).passes_complete(), 4u);  // block 0 sealed
+    EXPECT_EQ(coordinator->status(job).tasks_complete(), 8u);
+    token_before_restart = tasks[9].attempt_token();
+  }
+  auto coordinator = make();
+  v1::JobStatus status = coordinator->status(job);
+  EXPECT_EQ(status.passes_complete(), 4u);
+  EXPECT_EQ(status.tasks_complete(), 8u);
+  EXPECT_EQ(status.state(), v1::JOB_STATE_RUNNING);
+  std::string worker = register_worker(*coordinator, "w");
+  std::vector<v1::Task> tasks = lease(*coordinator, worker, 100);
+  ASSERT_EQ(tasks.size(), 10u) << "only the unfinished tasks are queued again";
+  for (const v1::Task& task : tasks) {
+    EXPECT_GE(task.task_index(), 8u);
+    EXPECT_NE(task.attempt_token(), token_before_restart);
+    EXPECT_TRUE(complete(*coordinator, worker, task));
+  }
+  EXPECT_EQ(coordinator->status(job).state(), v1::JOB_STATE_DONE);
+  EXPECT_TRUE(
+      testing::same_bits(coordinator->result_film(job).color, expected_film(40, 24, 12).color));
+}
+
+TEST_F(CoordinatorTest, SecondsBudgetOpensBlocksUntilTheBudgetIsSpent) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "w");
+  v1::JobSpec seconds_spec = spec(1);
+  seconds_spec.set_compute_seconds(1.0);
+  std::string job = coordinator->submit(seconds_spec).job_id();
+  // Each task costs 0.05 s: 6 tiles -> 0.3 s per block; blocks open while spent + in flight < 1.
+  int guard = 0;
+  while (coordinator->status(job).state() != v1::JOB_STATE_DONE && guard++ < 100) {
+    std::vector<v1::Task> tasks = lease(*coordinator, worker, 3);
+    ASSERT_FALSE(tasks.empty());
+    for (const v1::Task& task : tasks) EXPECT_TRUE(complete(*coordinator, worker, task, 0.05));
+  }
+  v1::JobStatus status = coordinator->status(job);
+  ASSERT_EQ(status.state(), v1::JOB_STATE_DONE);
+  EXPECT_EQ(status.passes_complete() % 4, 0u);
+  EXPECT_EQ(status.passes_complete(), status.passes_planned());
+  EXPECT_GE(status.compute_seconds(), 1.0 - 1e-9);
+  EXPECT_LE(status.compute_seconds(), 1.0 + 0.3 + 1e-9) << "at most one block past the budget";
+  EXPECT_TRUE(testing::same_bits(coordinator->result_film(job).color,
+                                 expected_film(40, 24, status.passes_complete()).color));
+}
+
+TEST_F(CoordinatorTest, MalformedResultsAreRefused) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "w");
+  coordinator->submit(spec(4));
+  std::vector<v1::Task> tasks = lease(*coordinator, worker, 2);
+  v1::CompleteTaskRequest request;
+  request.set_worker_id(worker);
+  request.set_job_id(tasks[0].job_id());
+  request.set_task_index(tasks[0].task_index());
+  request.set_attempt_token(tasks[0].attempt_token());
+  request.set_tile("garbage");
+  EXPECT_THROW(coordinator->complete_task(request), FarmError);
+  request.set_tile(fake_render(tasks[1]).serialize());  // another tile's rectangle
+  EXPECT_THROW(coordinator->complete_task(request), FarmError);
+  v1::Task short_task = tasks[0];
+  short_task.set_pass_end(2);  // fewer passes than asked
+  request.set_tile(fake_render(short_task).serialize());
+  EXPECT_THROW(coordinator->complete_task(request), FarmError);
+  EXPECT_TRUE(complete(*coordinator, worker, tasks[0]));
+}
+
+}  // namespace
+}  // namespace penumbra::farm

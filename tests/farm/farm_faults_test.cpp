@@ -1,0 +1,112 @@
+// Faults: a worker killed or terminated mid-job, a coordinator killed and restarted on its data
+// directory. The finished images stay bit-identical to a local render.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+
+#include "core/image/metrics.h"
+#include "farm_test_support.h"
+#include "penumbra/version.h"
+
+namespace penumbra::farm {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::CoordinatorProcess;
+using testing::expect_bit_identical;
+using testing::wait_until;
+
+TEST(FarmFaults, KilledWorkerLeasesExpireAndOthersFinishBitIdentical) {
+  auto dir = testing::fresh_directory("killed-worker");
+  std::string scene = testing::write_scene(dir, 96, 64);
+  CoordinatorProcess coordinator(dir / "data", 0, {}, 0.5);
+  auto victim = testing::start_worker(coordinator.address(), dir, "victim");
+  auto survivor = testing::start_worker(coordinator.address(), dir, "survivor");
+  FarmClient client(coordinator.address());
+  std::string job = client.submit(testing::job_spec(scene, "sa", 128, 11, 16, 8)).job_id();
+  // Kill the victim while it holds leases, after it has delivered some results.
+  auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (true) {
+    bool holding = false;
+    for (const v1::WorkerInfo& worker : client.workers())
+      holding |=
+          worker.name() == "victim" && worker.tasks_completed() >= 3 && worker.tasks_leased() > 0;
+    if (holding) break;
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the victim never held a lease";
+    std::this_thread::sleep_for(5ms);
+  }
+  victim->signal(SIGKILL);
+  victim->wait_exit(10s);
+  v1::JobStatus status = client.wait(job, 120s);
+  ASSERT_EQ(status.state(), v1::JOB_STATE_DONE) << status.error();
+  EXPECT_EQ(status.tasks_complete(), 24u * 16u);
+  expect_bit_identical(client, job, scene, "sa", 128, 11);
+  auto workers = client.workers();
+  ASSERT_EQ(workers.size(), 2u);
+  EXPECT_EQ(workers[0].tasks_completed() + workers[1].tasks_completed(), 24u * 16u)
+      << "a task was counted twice or lost";
+  std::ifstream log(dir / "data" / "coordinator.log");
+  std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("lease of worker w"), std::string::npos) << "no lease expired";
+}
+
+TEST(FarmFaults, TerminatedWorkerDrainsAndExitsCleanly) {
+  auto dir = testing::fresh_directory("drain");
+  std::string scene = testing::write_scene(dir, 96, 64);
+  CoordinatorProcess coordinator(dir / "data");
+  auto drained = testing::start_worker(coordinator.address(), dir, "drained");
+  auto other = testing::start_worker(coordinator.address(), dir, "other");
+  FarmClient client(coordinator.address());
+  std::string job = client.submit(testing::job_spec(scene, "sa", 64, 5, 16, 8)).job_id();
+  // Terminate it once it is running and holds leases.
+  auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (true) {
+    bool holding = false;
+    for (const v1::WorkerInfo& worker : client.workers())
+      holding |=
+          worker.name() == "drained" && worker.tasks_completed() >= 2 && worker.tasks_leased() > 0;
+    if (holding) break;
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the worker never held a lease";
+    std::this_thread::sleep_for(5ms);
+  }
+  drained->signal(SIGTERM);
+  EXPECT_EQ(drained->wait_exit(30s), 0);
+  v1::JobStatus status = client.wait(job, 120s);
+  ASSERT_EQ(status.state(), v1::JOB_STATE_DONE) << status.error();
+  expect_bit_identical(client, job, scene, "sa", 64, 5);
+}
+
+TEST(FarmFaults, CoordinatorKilledAndRestartedKeepsFinishedTiles) {
+  auto dir = testing::fresh_directory("restart");
+  std::string scene = testing::write_scene(dir, 96, 64);
+  auto coordinator = std::make_unique<CoordinatorProcess>(dir / "data");
+  int port = coordinator->port();
+  auto worker_a = testing::start_worker(coordinator->address(), dir, "a");
+  auto worker_b = testing::start_worker(coordinator->address(), dir, "b");
+  std::string job;
+  uint32_t passes_before = 0;
+  {
+    FarmClient client(coordinator->address());
+    job = client.submit(testing::job_spec(scene, "sa", 128, 3, 16, 8)).job_id();
+    passes_before = wait_until(client, job, [](const v1::JobStatus& s) {
+                      return s.passes_complete() >= 16;
+                    }).passes_complete();
+  }
+  coordinator->process().signal(SIGKILL);
+  coordinator->process().wait_exit(10s);
+  coordinator.reset();
+  // The same port and data directory: the workers reconnect by themselves.
+  coordinator = std::make_unique<CoordinatorProcess>(dir / "data", port);
+  FarmClient client(coordinator->address());
+  v1::JobStatus resumed = client.status(job);
+  EXPECT_GE(resumed.passes_complete(), passes_before) << "sealed passes were lost";
+  EXPECT_NE(resumed.state(), v1::JOB_STATE_FAILED) << resumed.error();
+  v1::JobStatus status = client.wait(job, 120s);
+  ASSERT_EQ(status.state(), v1::JOB_STATE_DONE) << status.error();
+  expect_bit_identical(client, job, scene, "sa", 128, 3);
+}
+
+}  // namespace
+}  // namespace penumbra::farm
