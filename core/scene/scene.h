@@ -100,10 +100,11 @@ struct SceneLimits {
   size_t max_triangles = 20'000'000;
   size_t max_lights = 4096;
   int max_sphere_subdivisions = 8;
-  double max_coordinate = 1e7;              // absolute value of any coordinate
-  size_t max_polygon_vertices = 1024;       // per polygon light
-  size_t max_file_bytes = size_t{1} << 30;  // the scene JSON and each OBJ file
-  int max_json_depth = 64;                  // nesting of JSON arrays and objects
+  double max_coordinate = 1e7;               // absolute value of any coordinate
+  size_t max_polygon_vertices = 1024;        // per polygon light
+  size_t max_json_bytes = size_t{64} << 20;  // the scene JSON text (big meshes go in OBJ files)
+  size_t max_file_bytes = size_t{1} << 30;   // each OBJ file
+  int max_json_depth = 64;                   // nesting of JSON arrays and objects
 };
 
 // Related headers: scene_package.h (scene and OBJ bytes in memory, for the farm, and the content

@@ -32,10 +32,10 @@ class SceneParser {
       : read_obj_(read_obj), source_(source), limits_(limits) {}
 
   ParsedScene parse(const std::string& json_text) {
-    if (json_text.size() > limits_.max_file_bytes)
+    if (json_text.size() > limits_.max_json_bytes)
       throw FormatError("$", "the scene has " + std::to_string(json_text.size()) +
-                                 " bytes, more than the limit max_file_bytes = " +
-                                 std::to_string(limits_.max_file_bytes) + " (in " + source_ + ")");
+                                 " bytes, more than the limit max_json_bytes = " +
+                                 std::to_string(limits_.max_json_bytes) + " (in " + source_ + ")");
     nlohmann::json document = parse_json_document(json_text, source_, limits_.max_json_depth);
     JsonNode root(document, "$", source_);
     root.expect_object();

@@ -30,7 +30,7 @@ std::string normalize_scene_relative_path(const std::string& path) {
   return normal.generic_string();
 }
 
-std::string read_whole_file(const std::string& path, size_t max_bytes) {
+std::string read_whole_file(const std::string& path, size_t max_bytes, const char* limit_name) {
   std::error_code error;
   fs::file_status status = fs::status(path, error);
   if (error || !fs::exists(status)) throw std::invalid_argument("cannot open '" + path + "'");
@@ -39,15 +39,16 @@ std::string read_whole_file(const std::string& path, size_t max_bytes) {
   uintmax_t size = fs::file_size(path, error);
   if (error) throw std::invalid_argument("cannot read the size of '" + path + "'");
   if (size > max_bytes)
-    throw std::invalid_argument(
-        "'" + path + "' has " + std::to_string(size) +
-        " bytes, more than the limit max_file_bytes = " + std::to_string(max_bytes));
+    throw std::invalid_argument("'" + path + "' has " + std::to_string(size) +
+                                " bytes, more than the limit " + limit_name + " = " +
+                                std::to_string(max_bytes));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument("cannot open '" + path + "'");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw std::invalid_argument("error while reading '" + path + "'");
   if (bytes.size() > max_bytes)
-    throw std::invalid_argument("'" + path + "' grew past the limit max_file_bytes while read");
+    throw std::invalid_argument("'" + path + "' grew past the limit " + std::string(limit_name) +
+                                " while read");
   return bytes;
 }
 

@@ -19,8 +19,9 @@ std::string normalize_scene_relative_path(const std::string& path);
 std::string read_file_inside(const std::string& base_dir, const std::string& relative_path,
                              size_t max_bytes);
 
-// Reads a whole file of at most `max_bytes`. Throws std::invalid_argument (missing, unreadable,
-// not a regular file, too large).
-std::string read_whole_file(const std::string& path, size_t max_bytes);
+// Reads a whole file of at most `max_bytes` (`limit_name` names that limit in the message).
+// Throws std::invalid_argument (missing, unreadable, not a regular file, too large).
+std::string read_whole_file(const std::string& path, size_t max_bytes,
+                            const char* limit_name = "max_file_bytes");
 
 }  // namespace penumbra

@@ -17,7 +17,7 @@ ObjFileReader folder_obj_reader(const std::string& base_dir, const SceneLimits& 
 
 std::string read_scene_text(const std::string& path, const SceneLimits& limits) {
   try {
-    return read_whole_file(path, limits.max_file_bytes);
+    return read_whole_file(path, limits.max_json_bytes, "max_json_bytes");
   } catch (const std::invalid_argument& error) {
     throw FormatError("", std::string("cannot load scene: ") + error.what());
   }

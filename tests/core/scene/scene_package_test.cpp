@@ -183,13 +183,27 @@ TEST(SceneFiles, ObjThatFailsToLoadNamesTheFile) {
   // An OBJ larger than the file limit is refused before it is read.
   folder.write("empty.obj", testing::tetrahedron_obj());
   SceneLimits limits;
-  limits.max_file_bytes = 2000;  // the scene JSON fits, so the OBJ is the one refused
+  limits.max_file_bytes = 2000;
   folder.write("empty.obj", std::string(4000, '#'));
   try {
     load_scene(scene_path, limits);
     FAIL() << "accepted an OBJ over the size limit";
   } catch (const FormatError& error) {
     EXPECT_NE(std::string(error.what()).find("max_file_bytes"), std::string::npos);
+  }
+  // A scene file over its own limit is refused before it is parsed, by either route.
+  limits = SceneLimits{};
+  limits.max_json_bytes = 100;
+  for (auto load :
+       {+[](const std::string&path, const SceneLimits&l) { load_scene(path, l); },
+        +[](const std::string&path, const SceneLimits&l) { collect_scene_package(path, l); }}) {
+    try {
+      load(scene_path, limits);
+      FAIL() << "accepted a scene over max_json_bytes";
+    } catch (const FormatError& error) {
+      EXPECT_NE(std::string(error.what()).find("max_json_bytes"), std::string::npos)
+          << error.what();
+    }
   }
 }
 
