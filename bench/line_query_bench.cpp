@@ -19,6 +19,7 @@
 #include <xmmintrin.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -74,11 +75,11 @@ BenchScene cornell_occluders() {
     scene.mesh.add_triangle(base, base + 1, base + 2);
     scene.mesh.add_triangle(base, base + 2, base + 3);
   };
-  add_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2});   // floor
-  add_quad({-1, 2, -1}, {2, 0, 0}, {0, 0, 2});   // ceiling
-  add_quad({-1, 0, -1}, {2, 0, 0}, {0, 2, 0});   // back
-  add_quad({-1, 0, -1}, {0, 0, 2}, {0, 2, 0});   // left
-  add_quad({1, 0, -1}, {0, 0, 2}, {0, 2, 0});    // right
+  add_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2});  // floor
+  add_quad({-1, 2, -1}, {2, 0, 0}, {0, 0, 2});  // ceiling
+  add_quad({-1, 0, -1}, {2, 0, 0}, {0, 2, 0});  // back
+  add_quad({-1, 0, -1}, {0, 0, 2}, {0, 2, 0});  // left
+  add_quad({1, 0, -1}, {0, 0, 2}, {0, 2, 0});   // right
   std::mt19937_64 rng(20);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int i = 0; i < 20; ++i) {
@@ -130,7 +131,7 @@ struct Prepared {
   double embree_build_seconds = 0;
   struct Query {
     Vec3 x;
-    Vec3 light_point;   // shadow ray target
+    Vec3 light_point;     // shadow ray target
     Vec3 line_a, line_b;  // line sample
   };
   std::vector<Query> queries;
@@ -140,9 +141,9 @@ struct Prepared {
     auto start = std::chrono::steady_clock::now();
     rtc_scene = rtcNewScene(device);
     RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-        scene.mesh.positions.size()));
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), scene.mesh.positions.size()));
     for (size_t i = 0; i < scene.mesh.positions.size(); ++i)
       for (int k = 0; k < 3; ++k)
         vertices[3 * i + k] = static_cast<float>(scene.mesh.positions[i][k]);
@@ -264,10 +265,26 @@ void shadow_rays(benchmark::State& state, const std::string& name) {
   state.SetLabel(prepared.scene.description);
 }
 
-void line_queries(benchmark::State& state, const std::string& name,
-                  LineQueryBuildQuality quality) {
+void line_queries(benchmark::State& state, const std::string& name, LineQueryBuildQuality quality) {
   Prepared& prepared = prepare(name);
   const LineQuery& line_query = prepared.line_query(quality);
+  // Measure only a query that gives the right answer: a sample against the brute force.
+  size_t checks = prepared.scene.mesh.triangle_count() > 100'000 ? 8 : 256;
+  for (size_t i = 0; i < checks && i < prepared.queries.size(); ++i) {
+    const Prepared::Query& query = prepared.queries[i * 97 % prepared.queries.size()];
+    IntervalList expected, actual;
+    visible_intervals_brute_force(prepared.scene.mesh.positions, prepared.scene.mesh.indices,
+                                  query.x, query.line_a, query.line_b, expected);
+    line_query.visible_intervals(query.x, query.line_a, query.line_b, actual);
+    bool same = expected.size() == actual.size();
+    for (size_t k = 0; same && k < actual.size(); ++k)
+      same = std::fabs(expected[k].lo - actual[k].lo) <= 1e-6 &&
+             std::fabs(expected[k].hi - actual[k].hi) <= 1e-6;
+    if (!same) {
+      state.SkipWithError("line query differs from the brute force");
+      return;
+    }
+  }
   IntervalList visible;
   LineQueryStats stats;
   size_t i = 0, fully_occluded = 0, count = 0, pieces = 0;
@@ -318,8 +335,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
       double medium = find(std::string("line_query_medium/") + scene);
       double high = find(std::string("line_query_high/") + scene);
       if (ray <= 0) continue;
-      std::printf("%-6s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene, ray, medium, medium / ray,
-                  high, high / ray);
+      std::printf("%-6s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene, ray, medium, medium / ray, high,
+                  high / ray);
     }
   }
 
@@ -340,11 +357,10 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark((std::string("shadow_ray/") + name).c_str(),
                                  [name](benchmark::State& state) { shadow_rays(state, name); })
         ->Unit(benchmark::kNanosecond);
-    benchmark::RegisterBenchmark(
-        (std::string("line_query_medium/") + name).c_str(),
-        [name](benchmark::State& state) {
-          line_queries(state, name, LineQueryBuildQuality::Medium);
-        })
+    benchmark::RegisterBenchmark((std::string("line_query_medium/") + name).c_str(),
+                                 [name](benchmark::State& state) {
+                                   line_queries(state, name, LineQueryBuildQuality::Medium);
+                                 })
         ->Unit(benchmark::kNanosecond);
     benchmark::RegisterBenchmark(
         (std::string("line_query_high/") + name).c_str(),

@@ -145,7 +145,7 @@ struct StackEntry {
 
 // Slack on projected t-ranges (t is in [0,1]): float rounding of one add and one divide.
 constexpr float kProjectionSlack = 1e-6f;
-constexpr int kStackCapacity = 256;  // depth <= 32 (Embree's maxDepth), 3 entries per level
+constexpr int kStackCapacity = 256;  // 3 entries per level: depth checked at build
 
 }  // namespace
 
