@@ -31,6 +31,11 @@ double cross2(const Vec2& a, const Vec2& b) {
 Vec2 rotate90(const Vec2& a) {
   return {-a.y, a.x};
 }
+// Plain cross product, where a rounding error in the last bits cannot matter (the safeguard's
+// bracket test, the initialization's quad areas).
+double cross2_plain(const Vec2& a, const Vec2& b) {
+  return a.x * b.y - a.y * b.x;
+}
 Vec2 normalize2(const Vec2& a) {
   double l = std::sqrt(dot2(a, a));
   return l > 0 ? scale2(a, 1.0 / l) : a;
@@ -63,7 +68,23 @@ Vec2 bisector(const Vec2& a, const Vec2& b) {
 // w is a non-zero finite direction in the sector from low to high (counter-clockwise).
 bool inside_bracket(const Vec2& low, const Vec2& w, const Vec2& high) {
   double l2 = dot2(w, w);
-  return l2 > 0 && std::isfinite(l2) && cross2(low, w) >= 0 && cross2(w, high) >= 0;
+  return l2 > 0 && std::isfinite(l2) && cross2_plain(low, w) >= 0 && cross2_plain(w, high) >= 0;
+}
+
+// ellipse_radius_squared and ellipse_one_minus_radius_squared with one division.
+void radius_squared_and_complement(const EdgeEllipse& e, const Vec2& w, double* r2,
+                                   double* one_minus_r2) {
+  double cw = e.c * e.c * dot2(w, w);
+  double mw = dot2(e.m, w);
+  double denominator = cw + mw * mw;
+  if (!(denominator > 0)) {
+    *r2 = 0.0;
+    *one_minus_r2 = 1.0;
+    return;
+  }
+  double inverse = 1.0 / denominator;
+  *r2 = std::min(1.0, cw * inverse);
+  *one_minus_r2 = std::min(1.0, mw * mw * inverse);
 }
 
 // dot(N, v0) for the polygon's area vector N: its sign is that of det(v0, v1, v2) for consecutive
@@ -251,8 +272,13 @@ ProjectedSolidAngleSampler::ProjectedSolidAngleSampler(std::span<const Vec3> ver
 void ProjectedSolidAngleSampler::add_sector(const Vec2& s0, const Vec2& s1,
                                             const EdgeEllipse& inner, const EdgeEllipse& outer) {
   Sector& s = sectors_[sector_count_++];
+  // Areas use the vertices' xy as they are (normalizing them costs accuracy in horizon slivers);
+  // the initialization and the safeguard use unit directions.
   s.s0 = s0;
   s.s1 = s1;
+  s.s0_unit = normalize2(s0);
+  s.s1_unit = normalize2(s1);
+  s.half = bisector(s.s0_unit, s.s1_unit);
   s.inner = inner;
   s.outer = outer;
   // Sector areas by Peters Eq. 1; the difference of outer and inner in the decentral case. A
@@ -260,10 +286,11 @@ void ProjectedSolidAngleSampler::add_sector(const Vec2& s0, const Vec2& s1,
   double area;
   if (inner.c == 0) {
     double abs_c = std::abs(outer.c);
-    s.angle = std::max(0.0, std::atan2(abs_c * cross2(s0, s1), ellipse_form(outer, s0, s1)));
+    s.angle =
+        std::max(0.0, std::atan2(abs_c * cross2(s.s0, s.s1), ellipse_form(outer, s.s0, s.s1)));
     area = 0.5 * abs_c * s.angle;
   } else {
-    area = area_up_to(s, s1);
+    area = area_up_to(s, s.s1);
   }
   s.area = std::isfinite(area) ? std::max(0.0, area) : 0.0;
   total_area_ += s.area;
@@ -324,8 +351,9 @@ Vec2 ProjectedSolidAngleSampler::single_ellipse_direction(const Sector& s, doubl
 Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double area) const {
   const EdgeEllipse& inner = s.inner;
   const EdgeEllipse& outer = s.outer;
-  Vec2 s0 = normalize2(s.s0), s1 = normalize2(s.s1);
-  Vec2 half = bisector(s0, s1);
+  const Vec2& s0 = s.s0_unit;
+  const Vec2& s1 = s.s1_unit;
+  const Vec2& half = s.half;
 
   // Two-quad initialization (Sec. 3.4): the points where the rays through s0, s_h and s1 meet
   // the inner and outer ellipses span two quads; the quad that holds the area is sampled
@@ -337,8 +365,8 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
        inner1 = on_ellipse(inner, s1);
   Vec2 outer0 = on_ellipse(outer, s0), outer_half = on_ellipse(outer, half),
        outer1 = on_ellipse(outer, s1);
-  double quad0 = 0.5 * (cross2(outer0, outer_half) - cross2(inner0, inner_half));
-  double quad1 = 0.5 * (cross2(outer_half, outer1) - cross2(inner_half, inner1));
+  double quad0 = 0.5 * (cross2_plain(outer0, outer_half) - cross2_plain(inner0, inner_half));
+  double quad1 = 0.5 * (cross2_plain(outer_half, outer1) - cross2_plain(inner_half, inner1));
   double quads = quad0 + quad1;
   double quad_area = (s.area > 0 && quads > 0) ? area * (quads / s.area) : 0.0;
   bool second = quad_area > quad0;
@@ -426,10 +454,9 @@ std::optional<Vec3> ProjectedSolidAngleSampler::sample(const Vec2& u) const {
   Vec2 w = single ? single_ellipse_direction(s, area) : two_ellipse_direction(s, area);
   // Radius: rho^2 uniform between the inner and outer ellipse (Sec. 3.3), z from 1 - rho^2
   // formed without cancellation (Eq. 2).
-  double inner_r2 = single ? 0.0 : ellipse_radius_squared(s.inner, w);
-  double inner_z2 = single ? 1.0 : ellipse_one_minus_radius_squared(s.inner, w);
-  double outer_r2 = ellipse_radius_squared(s.outer, w);
-  double outer_z2 = ellipse_one_minus_radius_squared(s.outer, w);
+  double inner_r2 = 0.0, inner_z2 = 1.0, outer_r2, outer_z2;
+  if (!single) radius_squared_and_complement(s.inner, w, &inner_r2, &inner_z2);
+  radius_squared_and_complement(s.outer, w, &outer_r2, &outer_z2);
   double rho2 = (1.0 - u.y) * inner_r2 + u.y * outer_r2;
   double z2 = (1.0 - u.y) * inner_z2 + u.y * outer_z2;
   Vec2 w_unit = normalize2(w);
@@ -450,9 +477,8 @@ std::optional<Vec2> ProjectedSolidAngleSampler::invert(const Vec3& direction) co
   for (int i = 0; i < sector_count_; ++i) {
     const Sector& s = sectors_[i];
     if (!(s.area > 0)) continue;
-    bool inside =
-        (rho2 == 0 && central_) || (cross2(s.s0, w) >= 0 && cross2(w, s.s1) >= 0 &&
-                                    dot2(w, add2(normalize2(s.s0), normalize2(s.s1))) >= 0);
+    bool inside = (rho2 == 0 && central_) ||
+                  (cross2(s.s0, w) >= 0 && cross2(w, s.s1) >= 0 && dot2(w, s.half) >= 0);
     if (!inside) {
       before += s.area;
       continue;

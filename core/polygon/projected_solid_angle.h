@@ -108,8 +108,10 @@ class ProjectedSolidAngleSampler {
 
  private:
   struct Sector {
-    Vec2 s0, s1;        // boundaries, counter-clockwise from s0 to s1
-    EdgeEllipse inner;  // c == 0: no inner ellipse (the origin bounds the sector)
+    Vec2 s0, s1;            // boundaries (vertices' xy), counter-clockwise from s0 to s1
+    Vec2 s0_unit, s1_unit;  // the same, normalized
+    Vec2 half;              // their bisector (Peters Eq. 8)
+    EdgeEllipse inner;      // c == 0: no inner ellipse (the origin bounds the sector)
     EdgeEllipse outer;
     double area = 0;   // projected solid angle inside the sector
     double angle = 0;  // single ellipse: its sector angle in the circle it maps to
