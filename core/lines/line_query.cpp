@@ -199,6 +199,19 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   nodes_.clear();
   triangles_.clear();
   if (occluders.empty()) return;
+  // Embree builds on boxes scaled by a power of two to a largest coordinate in [1, 2): its SAH
+  // then sees the same numbers at every scene scale (box areas of tiny scenes would otherwise
+  // be float denormals, flushed to zero on render threads). Exact both ways.
+  const float build_scale =
+      std::ldexp(1.0f, -std::ilogb(std::max(max_component(scene_max_abs_), 1e-30)));
+  for (RTCBuildPrimitive& primitive : primitives) {
+    primitive.lower_x *= build_scale;
+    primitive.lower_y *= build_scale;
+    primitive.lower_z *= build_scale;
+    primitive.upper_x *= build_scale;
+    primitive.upper_y *= build_scale;
+    primitive.upper_z *= build_scale;
+  }
   if (occluders.size() >= (size_t{1} << (31 - kCountBits)))
     throw std::invalid_argument("LineQuery: too many triangles (" +
                                 std::to_string(occluders.size()) + ")");
@@ -260,8 +273,10 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   };
   auto set_slot = [&](uint32_t index, int slot, const RTCBounds& bounds, uint32_t code) {
     Node& node = nodes_[index];
-    const double lower[3] = {bounds.lower_x, bounds.lower_y, bounds.lower_z};
-    const double upper[3] = {bounds.upper_x, bounds.upper_y, bounds.upper_z};
+    const double lower[3] = {bounds.lower_x / build_scale, bounds.lower_y / build_scale,
+                             bounds.lower_z / build_scale};
+    const double upper[3] = {bounds.upper_x / build_scale, bounds.upper_y / build_scale,
+                             bounds.upper_z / build_scale};
     for (int k = 0; k < 3; ++k) {
       // Round the centre, then grow the extent until the box holds [lower, upper].
       float center = static_cast<float>(0.5 * (lower[k] + upper[k]));
@@ -329,7 +344,9 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
 
   // The shadow triangle's planes as linear functions over boxes (see shadow_triangle.h):
   // distance to the plane, alpha, beta and depth s = alpha + beta.
-  const LinearRange4 distance_range(shadow->plane_normal, x, scene_max_abs_);
+  // (The plane test is homogeneous in the normal: normalized, so that it stays far from float
+  // denormals, which flush to zero, at any scene scale.)
+  const LinearRange4 distance_range(normalize(shadow->plane_normal), x, scene_max_abs_);
   const LinearRange4 alpha_range(shadow->alpha_gradient, x, scene_max_abs_);
   const LinearRange4 beta_range(shadow->beta_gradient, x, scene_max_abs_);
   const LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);

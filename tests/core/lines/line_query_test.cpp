@@ -4,6 +4,8 @@
 #include "core/lines/line_query.h"
 
 #include <gtest/gtest.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
 
 #include <cmath>
 #include <random>
@@ -489,24 +491,38 @@ TEST(LineQuery, ManyCoincidentTrianglesBuildAndQuery) {
 }
 
 TEST(LineQuery, ScalingTheSceneByPowersOfTwoGivesTheSameBits) {
+  // Render threads run with flush-to-zero and denormals-are-zero: so does this test, down to
+  // scales where squared lengths would be float denormals.
+  struct FlushDenormalsScope {
+    unsigned saved = _mm_getcsr();
+    FlushDenormalsScope() {
+      _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+      _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    }
+    ~FlushDenormalsScope() { _mm_setcsr(saved); }
+  } flush_denormals;
   TriangleMesh mesh = random_triangles_mesh(1000, {-1, -1, -1}, {1, 1, 1}, 0.1, 61);
   LineQuery unit_query(mesh.positions, mesh.indices);
-  for (double scale : {1024.0, 1.0 / 1024}) {
+  for (double scale : {1024.0, 1.0 / 1024, std::ldexp(1.0, -66), std::ldexp(1.0, 20)}) {
     TriangleMesh scaled = mesh;
     for (Vec3& p : scaled.positions) p = scale * p;
     LineQuery scaled_query(scaled.positions, scaled.indices);
     Random random(62);
+    // The culling scales too: the same triangles are tested.
+    LineQueryStats unit_stats, scaled_stats;
     for (int trial = 0; trial < 300; ++trial) {
       Vec3 x = random.in_box({-1, -2, -1}, {1, -1, 1});
       Vec3 a = random.in_box({-1, 1, -1}, {1, 2, 1}), b = random.in_box({-1, 1, -1}, {1, 2, 1});
-      IntervalList expected = query(unit_query, x, a, b);
-      IntervalList actual = query(scaled_query, scale * x, scale * a, scale * b);
+      IntervalList expected, actual;
+      unit_query.visible_intervals(x, a, b, expected, &unit_stats);
+      scaled_query.visible_intervals(scale * x, scale * a, scale * b, actual, &scaled_stats);
       ASSERT_EQ(actual.size(), expected.size());
       for (size_t i = 0; i < actual.size(); ++i) {
         EXPECT_EQ(actual[i].lo, expected[i].lo);
         EXPECT_EQ(actual[i].hi, expected[i].hi);
       }
     }
+    EXPECT_EQ(scaled_stats.triangles_tested, unit_stats.triangles_tested) << scale;
   }
 }
 
