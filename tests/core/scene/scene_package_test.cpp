@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <stdexcept>
 
 #include "core/scene/scene.h"
+#include "core/scene/scene_path.h"
 #include "scene_test_support.h"
 
 namespace penumbra {
@@ -125,6 +127,17 @@ TEST(ScenePackage, EscapingPathsAreRefusedWithoutTouchingTheFilesystem) {
       EXPECT_NE(std::string(error.what()).find("refused OBJ path"), std::string::npos);
     }
   }
+}
+
+TEST(SceneFiles, RelativePathRules) {
+  EXPECT_EQ(normalize_scene_relative_path("meshes/./a.obj"), "meshes/a.obj");
+  EXPECT_EQ(normalize_scene_relative_path("meshes/sub/../a.obj"), "meshes/a.obj");
+  EXPECT_EQ(normalize_scene_relative_path("a.obj"), "a.obj");
+  for (const char* refused : {"", ".", "..", "../a.obj", "a/../../b.obj", "/abs/a.obj",
+                              "meshes\\a.obj", "meshes/", "a/.."}) {
+    EXPECT_THROW(normalize_scene_relative_path(refused), std::invalid_argument) << refused;
+  }
+  EXPECT_THROW(normalize_scene_relative_path(std::string("a\0b.obj", 7)), std::invalid_argument);
 }
 
 TEST(SceneFiles, SymlinkResolvingOutsideTheSceneFolderIsRefused) {
