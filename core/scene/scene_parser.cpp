@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -89,6 +90,20 @@ class SceneParser {
         node.fail("coordinate " + number_text(v[axis]) +
                   " exceeds the limit max_coordinate = " + number_text(limits_.max_coordinate));
     return v;
+  }
+
+  // The point of a raw [x, y, z] when it is valid (finite numbers within the coordinate limit),
+  // else empty: the caller then goes through coordinate() for the error.
+  std::optional<Vec3> plain_coordinate(const nlohmann::json& value) const {
+    if (!value.is_array() || value.size() != 3) return std::nullopt;
+    Vec3 p;
+    for (int axis = 0; axis < 3; ++axis) {
+      const nlohmann::json& c = value[axis];
+      if (!c.is_number()) return std::nullopt;
+      p[axis] = c.get<double>();
+      if (!(std::abs(p[axis]) <= limits_.max_coordinate)) return std::nullopt;
+    }
+    return p;
   }
 
   double positive(const JsonNode& node, const char* what) const {
@@ -299,11 +314,20 @@ class SceneParser {
       const size_t vertex_count = positions.size();
       if (vertex_count > std::numeric_limits<uint32_t>::max())
         positions.fail("too many positions for 32-bit indices");
+      // Inline meshes can be large: take valid entries straight from the JSON and build a
+      // JsonNode (with its path) only to report a bad one.
       mesh.positions.reserve(vertex_count);
-      for (size_t v = 0; v < vertex_count; ++v)
-        mesh.positions.push_back(coordinate(positions.at(v)));
+      for (size_t v = 0; v < vertex_count; ++v) {
+        std::optional<Vec3> p = plain_coordinate(positions.value()[v]);
+        mesh.positions.push_back(p ? *p : coordinate(positions.at(v)));
+      }
       mesh.indices.reserve(index_count);
       for (size_t k = 0; k < index_count; ++k) {
+        const nlohmann::json& raw = indices.value()[k];
+        if (raw.is_number_unsigned() && raw.get<uint64_t>() < vertex_count) {
+          mesh.indices.push_back(static_cast<uint32_t>(raw.get<uint64_t>()));
+          continue;
+        }
         JsonNode index = indices.at(k);
         int64_t value = index.integer();
         if (value < 0 || static_cast<uint64_t>(value) >= vertex_count)
