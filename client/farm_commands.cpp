@@ -1,0 +1,323 @@
+// The client's farm commands: submit, watch, list, status, cancel, fetch, workers. Each talks to
+// the coordinator named by --coordinator or PENUMBRA_COORDINATOR through the jobs API
+// (proto/support/farm_client.h); gRPC errors reach the user as "CODE: what to fix".
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "client/commands.h"
+#include "proto/support/farm_client.h"
+#include "proto/support/scene_packing.h"
+
+namespace penumbra {
+
+namespace {
+
+using farm::FarmClient;
+
+std::string default_coordinator() {
+  const char* env = std::getenv("PENUMBRA_COORDINATOR");
+  return env && *env ? env : "127.0.0.1:7420";
+}
+
+void add_coordinator_option(CLI::App* command, std::string& coordinator) {
+  command->add_option("--coordinator", coordinator,
+                      "host:port of the coordinator (default: PENUMBRA_COORDINATOR or "
+                      "127.0.0.1:7420)");
+}
+
+std::string state_name(v1::JobState state) {
+  switch (state) {
+    case v1::JOB_STATE_QUEUED:
+      return "queued";
+    case v1::JOB_STATE_RUNNING:
+      return "running";
+    case v1::JOB_STATE_DONE:
+      return "done";
+    case v1::JOB_STATE_FAILED:
+      return "failed";
+    case v1::JOB_STATE_CANCELLED:
+      return "cancelled";
+    default:
+      return "unknown";
+  }
+}
+
+std::string budget_text(const v1::JobStatus& status) {
+  char text[64];
+  if (status.spp_budget())
+    std::snprintf(text, sizeof text, "%u spp", status.spp_budget());
+  else
+    std::snprintf(text, sizeof text, "%.4g s", status.seconds_budget());
+  return text;
+}
+
+// Fraction done: passes for an spp budget, compute seconds for a seconds budget.
+double fraction_done(const v1::JobStatus& status) {
+  if (status.state() == v1::JOB_STATE_DONE) return 1.0;
+  if (status.spp_budget() && status.tasks_total())
+    return double(status.tasks_complete()) / double(status.tasks_total());
+  if (status.seconds_budget() > 0)
+    return std::min(1.0, status.compute_seconds() / status.seconds_budget());
+  return 0.0;
+}
+
+std::string progress_line(const v1::JobStatus& status) {
+  double fraction = fraction_done(status);
+  constexpr int kBarWidth = 24;
+  int filled = int(std::lround(fraction * kBarWidth));
+  std::string bar =
+      "[" + std::string(size_t(filled), '#') + std::string(size_t(kBarWidth - filled), '-') + "]";
+  char text[256];
+  std::string eta = "--";
+  if (fraction > 0.01 && fraction < 1.0 && status.wall_seconds() > 0) {
+    char eta_text[32];
+    std::snprintf(eta_text, sizeof eta_text, "%.0f s",
+                  status.wall_seconds() * (1.0 - fraction) / fraction);
+    eta = eta_text;
+  } else if (fraction >= 1.0) {
+    eta = "0 s";
+  }
+  std::snprintf(text, sizeof text,
+                "%s %s %3.0f%%  %u spp  tiles %u/%u  compute %.1f s  wall %.1f s  ETA %s",
+                status.job_id().c_str(), bar.c_str(), fraction * 100, status.passes_complete(),
+                status.tiles_complete(), status.tiles_total(), status.compute_seconds(),
+                status.wall_seconds(), eta.c_str());
+  std::string line = text;
+  if (status.has_mrse()) {
+    std::snprintf(text, sizeof text, "  MRSE %.4g", status.mrse());
+    line += text;
+  }
+  return line + "  " + state_name(status.state());
+}
+
+// Follows a job until it ends: a live bar on a terminal, a line per second otherwise.
+// Returns the final status; sets a failing exit code when the job did not finish.
+v1::JobStatus watch_job(FarmClient& client, const std::string& job_id) {
+  const bool terminal = isatty(STDOUT_FILENO);
+  auto last_print = std::chrono::steady_clock::now() - std::chrono::hours(1);
+  std::string last_line;
+  v1::JobStatus last = client.watch(job_id, [&](const v1::JobStatus& status) {
+    auto now = std::chrono::steady_clock::now();
+    if (terminal) {
+      std::printf("\r\033[K%s", progress_line(status).c_str());
+      std::fflush(stdout);
+    } else if (now - last_print >= std::chrono::seconds(1)) {
+      last_line = progress_line(status);
+      std::printf("%s\n", last_line.c_str());
+      std::fflush(stdout);
+      last_print = now;
+    }
+  });
+  if (terminal)
+    std::printf("\r\033[K%s\n", progress_line(last).c_str());
+  else if (progress_line(last) != last_line)
+    std::printf("%s\n", progress_line(last).c_str());
+  if (last.state() != v1::JOB_STATE_DONE) {
+    std::fprintf(stderr, "penumbra: %s %s%s%s\n", job_id.c_str(), state_name(last.state()).c_str(),
+                 last.error().empty() ? "" : ": ", last.error().c_str());
+    set_command_exit_code(1);
+  }
+  return last;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+struct SubmitArguments {
+  std::string coordinator = default_coordinator();
+  std::string scene, method = "sa", sampler = "stratified", reference, name;
+  uint32_t spp = 0;
+  double seconds = 0;
+  int priority = 0;
+  uint64_t seed = 0;
+  uint32_t tile_size = 0, passes_per_task = 0;
+  bool wait = false;
+};
+
+void submit(const SubmitArguments& arguments) {
+  if ((arguments.spp > 0) == (arguments.seconds > 0))
+    throw std::runtime_error("give exactly one budget: --spp N or --seconds S");
+  v1::JobSpec spec;
+  *spec.mutable_scene() = farm::pack_scene_file(arguments.scene);
+  spec.set_method(arguments.method);
+  spec.set_sampler(arguments.sampler);
+  spec.set_seed(arguments.seed);
+  if (arguments.spp > 0)
+    spec.set_spp(arguments.spp);
+  else
+    spec.set_compute_seconds(arguments.seconds);
+  spec.set_priority(arguments.priority);
+  spec.set_tile_size(arguments.tile_size);
+  spec.set_passes_per_task(arguments.passes_per_task);
+  spec.set_name(arguments.name);
+  if (!arguments.reference.empty()) {
+    if (std::filesystem::is_regular_file(arguments.reference))
+      spec.set_reference_exr(read_file(arguments.reference));
+    else
+      spec.set_reference_job(arguments.reference);
+  }
+  FarmClient client(arguments.coordinator);
+  v1::SubmitJobResponse response = client.submit(spec);
+  std::printf("%s submitted (scene %s)\n", response.job_id().c_str(),
+              response.scene_hash().substr(0, 12).c_str());
+  std::fflush(stdout);
+  if (arguments.wait) watch_job(client, response.job_id());
+}
+
+void print_status(const v1::JobStatus& status) {
+  std::printf("job        %s%s%s\n", status.job_id().c_str(), status.name().empty() ? "" : "  ",
+              status.name().c_str());
+  std::printf("state      %s%s%s\n", state_name(status.state()).c_str(),
+              status.error().empty() ? "" : ": ", status.error().c_str());
+  std::printf("scene      %s (%ux%u, %s)\n", status.scene_name().c_str(), status.width(),
+              status.height(), status.scene_hash().substr(0, 12).c_str());
+  std::printf("method     %s, sampler %s, seed %llu, priority %d\n", status.method().c_str(),
+              status.sampler().c_str(), static_cast<unsigned long long>(status.seed()),
+              status.priority());
+  std::printf("budget     %s\n", budget_text(status).c_str());
+  std::printf("progress   %u spp complete of %u planned; tiles %u/%u; tasks %llu/%llu\n",
+              status.passes_complete(), status.passes_planned(), status.tiles_complete(),
+              status.tiles_total(), static_cast<unsigned long long>(status.tasks_complete()),
+              static_cast<unsigned long long>(status.tasks_total()));
+  std::printf("time       %.2f compute s, %.2f wall s\n", status.compute_seconds(),
+              status.wall_seconds());
+  if (status.curve_size()) {
+    std::printf("MRSE curve (passes, compute s, wall s, MRSE):\n");
+    for (const auto& point : status.curve())
+      std::printf("  %6u  %9.3f  %9.3f  %.6g\n", point.passes(), point.compute_seconds(),
+                  point.wall_seconds(), point.mrse());
+  }
+  if (status.errors_size()) {
+    std::printf("errors against the reference:\n");
+    for (const auto& error : status.errors())
+      std::printf("  %-16s MRSE %.6g  MSE %.6g  RMSE %.6g\n", error.region().c_str(), error.mrse(),
+                  error.mse(), error.rmse());
+  }
+}
+
+}  // namespace
+
+void add_farm_commands(CLI::App& app) {
+  auto submit_arguments = std::make_shared<SubmitArguments>();
+  CLI::App* submit_command = app.add_subcommand(
+      "submit", "Submit a render job to the farm (packs the scene and its OBJs)");
+  submit_command->add_option("scene", submit_arguments->scene, "Scene file (penumbra/scene@1)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  submit_command->add_option("--method", submit_arguments->method, "Method (penumbra/method@1)");
+  submit_command->add_option("--sampler", submit_arguments->sampler, "Sample pattern");
+  submit_command->add_option("--spp", submit_arguments->spp, "Budget: samples per pixel");
+  submit_command->add_option("--seconds", submit_arguments->seconds,
+                             "Budget: summed compute seconds (stops at a pass boundary)");
+  submit_command->add_option("--reference", submit_arguments->reference,
+                             "Reference: an EXR file or a job id");
+  submit_command->add_option("--priority", submit_arguments->priority, "Higher runs first");
+  submit_command->add_option("--seed", submit_arguments->seed, "Random seed");
+  submit_command->add_option("--tile-size", submit_arguments->tile_size, "Tile side (64)");
+  submit_command->add_option("--passes-per-task", submit_arguments->passes_per_task,
+                             "Passes in one task (8)");
+  submit_command->add_option("--name", submit_arguments->name, "A label for the job");
+  submit_command->add_flag("--wait", submit_arguments->wait, "Watch the job until it ends");
+  add_coordinator_option(submit_command, submit_arguments->coordinator);
+  submit_command->callback([submit_arguments] { submit(*submit_arguments); });
+
+  struct JobArguments {
+    std::string coordinator = default_coordinator();
+    std::string job;
+    std::string output;
+  };
+  auto job_command = [&app](const std::string& name, const std::string& description,
+                            std::shared_ptr<JobArguments> arguments) {
+    CLI::App* command = app.add_subcommand(name, description);
+    command->add_option("job", arguments->job, "Job id (job-N)")->required();
+    add_coordinator_option(command, arguments->coordinator);
+    return command;
+  };
+
+  auto watch_arguments = std::make_shared<JobArguments>();
+  job_command("watch", "Follow a job's progress: spp, tiles, ETA, current MRSE", watch_arguments)
+      ->callback([watch_arguments] {
+        FarmClient client(watch_arguments->coordinator);
+        watch_job(client, watch_arguments->job);
+      });
+
+  auto status_arguments = std::make_shared<JobArguments>();
+  job_command("status", "Show a job: state, progress, MRSE curve, errors", status_arguments)
+      ->callback([status_arguments] {
+        FarmClient client(status_arguments->coordinator);
+        print_status(client.status(status_arguments->job));
+      });
+
+  auto cancel_arguments = std::make_shared<JobArguments>();
+  job_command("cancel", "Cancel a job", cancel_arguments)->callback([cancel_arguments] {
+    FarmClient client(cancel_arguments->coordinator);
+    v1::JobState state = client.cancel(cancel_arguments->job);
+    std::printf("%s %s\n", cancel_arguments->job.c_str(), state_name(state).c_str());
+  });
+
+  auto fetch_arguments = std::make_shared<JobArguments>();
+  CLI::App* fetch_command = job_command(
+      "fetch", "Download a finished job's EXR (RGB, variance, metadata)", fetch_arguments);
+  fetch_command->add_option("-o,--output", fetch_arguments->output, "Output EXR path")->required();
+  fetch_command->callback([fetch_arguments] {
+    FarmClient client(fetch_arguments->coordinator);
+    std::string bytes = client.fetch(fetch_arguments->job);
+    std::string temporary = fetch_arguments->output + ".part";
+    {
+      std::ofstream out(temporary, std::ios::binary);
+      out.write(bytes.data(), std::streamsize(bytes.size()));
+      if (!out) throw std::runtime_error("cannot write " + temporary);
+    }
+    std::filesystem::rename(temporary, fetch_arguments->output);
+    std::printf("%s -> %s (%zu bytes)\n", fetch_arguments->job.c_str(),
+                fetch_arguments->output.c_str(), bytes.size());
+  });
+
+  auto list_coordinator = std::make_shared<std::string>(default_coordinator());
+  CLI::App* list_command = app.add_subcommand("list", "List the farm's jobs");
+  add_coordinator_option(list_command, *list_coordinator);
+  list_command->callback([list_coordinator] {
+    FarmClient client(*list_coordinator);
+    std::printf("%-9s %-10s %4s %-20s %-16s %-10s %9s %10s %10s\n", "JOB", "STATE", "PRIO", "SCENE",
+                "METHOD", "BUDGET", "SPP", "COMPUTE s", "MRSE");
+    for (const v1::JobStatus& job : client.list()) {
+      char mrse[32] = "-";
+      if (job.has_mrse()) std::snprintf(mrse, sizeof mrse, "%.4g", job.mrse());
+      std::printf("%-9s %-10s %4d %-20s %-16s %-10s %9u %10.2f %10s\n", job.job_id().c_str(),
+                  state_name(job.state()).c_str(), job.priority(), job.scene_name().c_str(),
+                  job.method().c_str(), budget_text(job).c_str(), job.passes_complete(),
+                  job.compute_seconds(), mrse);
+    }
+  });
+
+  auto workers_coordinator = std::make_shared<std::string>(default_coordinator());
+  CLI::App* workers_command = app.add_subcommand("workers", "List the farm's workers");
+  add_coordinator_option(workers_command, *workers_coordinator);
+  workers_command->callback([workers_coordinator] {
+    FarmClient client(*workers_coordinator);
+    std::printf("%-24s %-6s %7s %7s %10s %11s %s\n", "WORKER", "ALIVE", "THREADS", "LEASED",
+                "COMPLETED", "COMPUTE s", "LAST SEEN");
+    for (const v1::WorkerInfo& worker : client.workers())
+      std::printf("%-24s %-6s %7u %7u %10llu %11.2f %.1f s ago\n", worker.worker_id().c_str(),
+                  worker.alive() ? "yes" : "no", worker.threads(), worker.tasks_leased(),
+                  static_cast<unsigned long long>(worker.tasks_completed()),
+                  worker.compute_seconds(), worker.seconds_since_heartbeat());
+  });
+}
+
+}  // namespace penumbra
