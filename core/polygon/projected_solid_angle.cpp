@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 namespace penumbra {
 
@@ -42,12 +44,6 @@ Vec2 normalize2(const Vec2& a) {
 }
 
 using Mat2 = std::array<double, 4>;  // row-major {xx, xy, yx, yy}
-Mat2 outer_product(const Vec2& a, const Vec2& b) {
-  return {a.x * b.x, a.x * b.y, a.y * b.x, a.y * b.y};
-}
-Mat2 subtract(const Mat2& a, const Mat2& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]};
-}
 
 // C w with C = c^2 I + m m^T.
 Vec2 apply_ellipse(const EdgeEllipse& e, const Vec2& w) {
@@ -63,6 +59,23 @@ double ellipse_form(const EdgeEllipse& e, const Vec2& a, const Vec2& b) {
 // their sum (Peters Eq. 8), or near 180 degrees the rotated difference, the stable form there.
 Vec2 bisector(const Vec2& a, const Vec2& b) {
   return normalize2(dot2(a, b) >= 0 ? add2(a, b) : Vec2{b.y - a.y, a.x - b.x});
+}
+
+// The root t of a0 + a1 t + a2 t^2 = 0 that has the sign of `direction` (or is 0) and, of two
+// such roots, the smaller one; both roots in the stable form. Empty if there is none. Used for
+// steps w = w_n + t R w_n from a direction w_n whose quadratic vanishes at t = 0 when a0 = 0:
+// the root selection by the sign of a1 (Blinn; Peters Eq. 6) fails where a1, the density, is
+// rounding noise (at the ends of the polygon, where the ellipses meet).
+std::optional<double> step_root(double a0, double a1, double a2, double direction) {
+  double root = safe_sqrt(difference_of_products(a1, a1, 4.0 * a0, a2));
+  double q_half = -0.5 * (a1 + std::copysign(root, a1));
+  double t1 = q_half != 0 ? a0 / q_half : 0.0;
+  double t2 = a2 != 0 ? q_half / a2 : 0.0;
+  bool t1_ok = t1 * direction >= 0 && std::isfinite(t1);
+  bool t2_ok = t2 * direction > 0 && std::isfinite(t2);
+  if (t1_ok && (!t2_ok || std::abs(t1) <= std::abs(t2))) return t1;
+  if (t2_ok) return t2;
+  return std::nullopt;
 }
 
 // w is a non-zero finite direction in the sector from low to high (counter-clockwise).
@@ -322,18 +335,18 @@ double ProjectedSolidAngleSampler::area_up_to(const Sector& s, const Vec2& w) co
 
 int ProjectedSolidAngleSampler::select_sector(double u0, double* area_in_sector) const {
   double target = u0 * total_area_;
-  double before = 0;
+  double before = 0, chosen_before = 0;
   int chosen = -1;
   for (int i = 0; i < sector_count_; ++i) {
     if (!(sectors_[i].area > 0)) continue;
     chosen = i;
+    chosen_before = before;
     if (target < before + sectors_[i].area) break;
     before += sectors_[i].area;
   }
   if (chosen < 0) return -1;
-  // The last sector also absorbs rounding in the running sum.
-  if (target >= before + sectors_[chosen].area) before = total_area_ - sectors_[chosen].area;
-  *area_in_sector = std::clamp(target - before, 0.0, sectors_[chosen].area);
+  // Past the end by rounding of the running sum: the last sector, at its end.
+  *area_in_sector = std::clamp(target - chosen_before, 0.0, sectors_[chosen].area);
   return chosen;
 }
 
@@ -370,23 +383,30 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
   double quads = quad0 + quad1;
   double quad_area = (s.area > 0 && quads > 0) ? area * (quads / s.area) : 0.0;
   bool second = quad_area > quad0;
-  // Measured from s1, clockwise: a negative signed area.
-  if (second) quad_area -= quads;
+  // Measured from s1, clockwise: a negative signed area (never positive by rounding).
+  if (second) quad_area = std::min(0.0, quad_area - quads);
   Vec2 inner_k = second ? inner1 : inner0;
   Vec2 outer_k = second ? outer1 : outer0;
   // Quad edges r_l^T q = D_l (Peters Supplement A.4, scaled by c_l^2): r_l = C (p_h + p_k),
-  // D_l = p_h^T r_l.
+  // D_l = p_h^T r_l. Peters' Q = D_o R p_ok r_i^T - (D_i R p_ik + 2 A_q r_i) r_o^T, written for
+  // w = s_k + t R s_k (s_k unit) as b0 + b1 t + b2 t^2 = 0 and solved for the small root like
+  // the iteration below: at the polygon's ends the two roots of Q coincide (p_ik = p_ok).
   Vec2 r_inner = apply_ellipse(inner, add2(inner_half, inner_k));
   Vec2 r_outer = apply_ellipse(outer, add2(outer_half, outer_k));
   double d_inner = dot2(inner_half, r_inner);
   double d_outer = dot2(outer_half, r_outer);
-  // Q = D_o R p_ok r_i^T - (D_i R p_ik + 2 A_q r_i) r_o^T.
-  Mat2 q = subtract(
-      outer_product(scale2(rotate90(outer_k), d_outer), r_inner),
-      outer_product(add2(scale2(rotate90(inner_k), d_inner), scale2(r_inner, 2.0 * quad_area)),
-                    r_outer));
-  Vec2 w = solve_homogeneous_quadratic(q);
-  if (dot2(w, half) < 0) w = scale2(w, -1.0);
+  const Vec2& boundary = second ? s1 : s0;
+  Vec2 normal = rotate90(boundary);
+  double ia = dot2(r_inner, boundary), ie = dot2(r_inner, normal);
+  double oa = dot2(r_outer, boundary), oe = dot2(r_outer, normal);
+  double outer_length = std::sqrt(dot2(outer_k, outer_k));
+  double inner_length = std::sqrt(dot2(inner_k, inner_k));
+  double b0 = -2.0 * quad_area * ia * oa;
+  double b1 = d_outer * outer_length * ia - d_inner * inner_length * oa -
+              2.0 * quad_area * (ia * oe + ie * oa);
+  double b2 = d_outer * outer_length * ie - d_inner * inner_length * oe - 2.0 * quad_area * ie * oe;
+  std::optional<double> t0 = step_root(b0, b1, b2, quad_area);
+  Vec2 w = t0 ? add2(boundary, scale2(normal, *t0)) : half;
   // Safeguard (ours, not in the paper): the area up to w grows monotonically with the angle, so
   // the residual's sign tells on which side of w the answer lies. An iterate that leaves the
   // sector (or is not finite) is replaced by the bisector of the bracket those signs give. This
@@ -410,18 +430,30 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
   // cancels, leaving ~1e-5 backward errors in double; the step form keeps full precision.
   double co2 = outer.c * outer.c, ci2 = inner.c * inner.c;
   double converged = 1e-13 * s.area;
-  double previous_residual = s.area;
+  Vec2 best = w;
+  double best_residual = std::numeric_limits<double>::infinity();
+  bool unverified_risky_step = false;
   for (int iteration = 0; iteration < iterations_; ++iteration) {
     // Past two iterations, a step only runs if the previous residual was large: convergence is
-    // cubic (Sec. 3.5), so from a residual below 1e-4 of the sector the step just taken left
+    // cubic (Sec. 3.5), so from a residual below 1e-6 of the sector the step just taken left
     // ~1e-12 (measured in projected_solid_angle_test.cpp). This keeps the third iteration's two
-    // arctangents for the ~1% of samples that need it.
-    if (iteration >= 2 && std::abs(previous_residual) <= 1e-6 * s.area) break;
+    // arctangents for the few percent of samples that need it.
+    if (iteration >= 2 && std::abs(best_residual) <= 1e-6 * s.area) break;
     Vec2 wn = normalize2(w);
     double residual = area - area_up_to(s, wn);
-    previous_residual = residual;
+    unverified_risky_step = false;
+    // Where the density vanishes (the polygon's clockwise and counter-clockwise ends, Sec. 3.5,
+    // above all a clipped vertex where an edge's ellipse touches the horizon circle) the tangent
+    // lines are a poor model and a step can make things worse; the best iterate is kept.
+    if (std::abs(residual) < std::abs(best_residual)) {
+      best = wn;
+      best_residual = residual;
+    }
     // Converged to rounding level: further steps would only move w by rounding noise.
-    if (std::abs(residual) <= converged) break;
+    if (std::abs(residual) <= converged) {
+      w = wn;
+      break;
+    }
     if (residual > 0)
       low = wn;
     else
@@ -436,11 +468,24 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
     double a0 = -2.0 * residual * pw * qw;
     double a1 = dot2(g, wn) - 2.0 * residual * (pw * qe + pe * qw);
     double a2 = dot2(g, e) - 2.0 * residual * pe * qe;
-    double root = safe_sqrt(difference_of_products(a1, a1, 4.0 * a0, a2));
-    double denominator = a1 + std::copysign(root, a1);
-    Vec2 next = add2(wn, scale2(e, denominator != 0 ? -2.0 * a0 / denominator : 0.0));
+    // The step goes the way the residual asks (counter-clockwise for a positive residual).
+    std::optional<double> step = step_root(a0, a1, a2, residual);
+    Vec2 next = step ? add2(wn, scale2(e, *step)) : Vec2{};  // none: bisect below
+    // Risky: the quadratic term dominates (vanishing density), so the model decides the step.
+    unverified_risky_step = !(a1 * a1 > 16.0 * std::abs(a0 * a2));
     // A step that leaves the sector (or is not finite) is replaced by bisection.
-    w = inside_bracket(s0, next, s1) ? next : bisector(normalize2(low), normalize2(high));
+    if (!inside_bracket(s0, next, s1)) {
+      next = bisector(normalize2(low), normalize2(high));
+      unverified_risky_step = true;
+    }
+    w = next;
+  }
+  // The last step was not checked by a following iteration: check it if it was risky.
+  if (unverified_risky_step) {
+    double residual = area - area_up_to(s, normalize2(w));
+    if (!(std::abs(residual) < std::abs(best_residual))) w = best;
+  } else if (std::abs(best_residual) <= converged) {
+    w = best;
   }
   return w;
 }
@@ -473,24 +518,48 @@ std::optional<Vec2> ProjectedSolidAngleSampler::invert(const Vec3& direction) co
   if (!(l2 > 0)) return std::nullopt;
   Vec2 w = xy(direction);
   double rho2 = dot2(w, w) / l2;
-  double before = 0;
+  // The sector holding w's azimuth, and the area of the sectors before it.
+  int index = -1, first = -1, last = -1;
+  double before = 0, before_index = 0, before_last = 0;
   for (int i = 0; i < sector_count_; ++i) {
     const Sector& s = sectors_[i];
     if (!(s.area > 0)) continue;
+    if (first < 0) first = i;
+    last = i;
+    before_last = before;
     bool inside = (rho2 == 0 && central_) ||
                   (cross2(s.s0, w) >= 0 && cross2(w, s.s1) >= 0 && dot2(w, s.half) >= 0);
-    if (!inside) {
-      before += s.area;
-      continue;
+    if (inside && index < 0) {
+      index = i;
+      before_index = before;
     }
-    bool single = s.inner.c == 0;
-    double area = rho2 == 0 ? 0.0 : std::clamp(area_up_to(s, w), 0.0, s.area);
-    double inner_r2 = single ? 0.0 : ellipse_radius_squared(s.inner, w);
-    double outer_r2 = rho2 == 0 ? 1.0 : ellipse_radius_squared(s.outer, w);
-    double u1 = outer_r2 > inner_r2 ? (rho2 - inner_r2) / (outer_r2 - inner_r2) : 0.0;
-    return Vec2{std::clamp((before + area) / total_area_, 0.0, 1.0), std::clamp(u1, 0.0, 1.0)};
+    before += s.area;
   }
-  return std::nullopt;
+  if (index < 0 && first >= 0) {
+    // Just outside the polygon's clockwise or counter-clockwise end by rounding (a sample drawn
+    // at u.x = 0 or 1): the end itself. Farther out, w is not in the polygon.
+    Vec2 unit = normalize2(w);
+    const double kRounding = 1e-9;
+    if (std::abs(cross2(sectors_[first].s0_unit, unit)) <= kRounding &&
+        dot2(sectors_[first].s0_unit, unit) > 0) {
+      index = first;
+      before_index = 0;
+    } else if (std::abs(cross2(sectors_[last].s1_unit, unit)) <= kRounding &&
+               dot2(sectors_[last].s1_unit, unit) > 0) {
+      index = last;
+      before_index = before_last;
+    } else {
+      return std::nullopt;
+    }
+  }
+  if (index < 0) return std::nullopt;
+  const Sector& s = sectors_[index];
+  bool single = s.inner.c == 0;
+  double area = rho2 == 0 ? 0.0 : std::clamp(area_up_to(s, w), 0.0, s.area);
+  double inner_r2 = single ? 0.0 : ellipse_radius_squared(s.inner, w);
+  double outer_r2 = rho2 == 0 ? 1.0 : ellipse_radius_squared(s.outer, w);
+  double u1 = outer_r2 > inner_r2 ? (rho2 - inner_r2) / (outer_r2 - inner_r2) : 0.0;
+  return Vec2{std::clamp((before_index + area) / total_area_, 0.0, 1.0), std::clamp(u1, 0.0, 1.0)};
 }
 
 double ProjectedSolidAngleSampler::area_cancellation(double u0) const {

@@ -134,6 +134,35 @@ TEST(ProjectedSolidAngle, SamplesLieInThePolygonAndInvertToTheirInput) {
   EXPECT_GT(samples, 10000);
 }
 
+TEST(ProjectedSolidAngle, ExtremePrimarySamplesReachThePolygonsEnds) {
+  std::mt19937_64 rng(43);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<Vec3> polygon = random_configuration(rng);
+    ProjectedSolidAngleSampler sampler(polygon);
+    if (sampler.projected_solid_angle() == 0) continue;
+    // The polygon's ends, where the ellipses meet and the density vanishes (Sec. 3.5).
+    for (Vec2 u :
+         {Vec2{0, 0}, Vec2{0, 1}, Vec2{1, 0}, Vec2{1, 1}, Vec2{1e-12, 0.5}, Vec2{1e-6, 0.5},
+          Vec2{1 - 1e-6, 0.5}, Vec2{1 - 1e-12, 0.5}, Vec2{std::nextafter(1.0, 0.0), 0.5}}) {
+      std::optional<Vec3> d = sampler.sample(u);
+      ASSERT_TRUE(d.has_value());
+      ASSERT_TRUE(is_finite(*d));
+      EXPECT_TRUE(hits_polygon(polygon, *d, 1e-6)) << "trial " << trial;
+      // Central case: u.y = 0 is the zenith, whose azimuth (u.x) is undefined.
+      if (sampler.is_central() && u.y == 0) continue;
+      std::optional<Vec2> back = sampler.invert(*d);
+      ASSERT_TRUE(back.has_value()) << "trial " << trial;
+      // Central case: the azimuth wraps around, u.x = 1 is u.x = 0.
+      double difference = std::abs(back->x - u.x);
+      if (sampler.is_central()) difference = std::min(difference, 1.0 - difference);
+      EXPECT_LT(difference, 1e-7) << "trial " << trial << " u " << u.x << " " << u.y;
+      if (sampler.area_cancellation(u.x) < 1e10) {
+        EXPECT_LT(sampler.backward_error(u, *d), 1e-5) << "trial " << trial << " u " << u.x;
+      }
+    }
+  }
+}
+
 TEST(ProjectedSolidAngle, CentralCaseRadiusInverts) {
   // Zenith inside: every sector has one ellipse, so u.y maps to rho^2 = u.y r_max^2 exactly.
   std::vector<Vec3> quad = {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
