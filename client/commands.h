@@ -5,6 +5,7 @@
 namespace penumbra {
 // render, probe, demo: core only.
 void add_local_commands(CLI::App& app);
+void add_reproduce_command(CLI::App& app);
 // submit, watch, list, status, cancel, fetch, workers: the farm's client (client/farm_*.cpp).
 void add_farm_commands(CLI::App& app);
 // The exit code the command that ran asked for (0 unless it reported a failure itself).

@@ -170,6 +170,7 @@ void add_local_commands(CLI::App& app) {
   demo->add_option("--seconds", dargs->seconds, "Compute seconds per method")->check(CLI::PositiveNumber);
   demo->add_option("--threads", dargs->threads, "Threads (0: all cores)");
   demo->callback([dargs] { run_local_demo(dargs->output, dargs->seconds, dargs->threads); });
+  add_reproduce_command(app);
 }
 
 }  // namespace penumbra

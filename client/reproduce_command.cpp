@@ -1,0 +1,72 @@
+// `penumbra reproduce [--quick|--full] [-o DIR]`: reruns the papers' experiments
+// (core/analysis/reproduction_suite.h), prints one table (paper figure beside ours, with pass or
+// fail), writes one chart per figure (SVG and PNG) and the table as JSON into DIR. Exit code 4
+// when a row fails.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+
+#include "client/commands.h"
+#include "core/analysis/reproduction_suite.h"
+
+namespace penumbra {
+
+namespace {
+
+struct ReproduceArgs {
+  bool quick = false, full = false;
+  std::string output = "reproduce-out";
+  std::string scenes = PENUMBRA_SCENES_DIR;
+  int threads = 0;
+};
+
+void run_reproduce(const ReproduceArgs& args) {
+  ReproductionOptions options;
+  options.full = args.full;
+  options.scenes_dir = args.scenes;
+  options.threads = args.threads;
+  options.progress = [](const std::string& line) {
+    std::fprintf(stderr, "reproduce: %s\n", line.c_str());
+  };
+  ReproductionReport report = run_reproduction_suite(options);
+
+  std::printf("%s", format_reproduction_table(report).c_str());
+  std::filesystem::create_directories(args.output);
+  std::filesystem::path json_path = std::filesystem::path(args.output) / "reproduce.json";
+  {
+    std::ofstream out(json_path);
+    out << reproduction_json(report) << "\n";
+    if (!out) throw std::runtime_error("cannot write " + json_path.string());
+  }
+  std::filesystem::path details_path = std::filesystem::path(args.output) / "details.txt";
+  {
+    std::ofstream out(details_path);
+    for (const std::string& table : report.details) out << table << "\n";
+    if (!out) throw std::runtime_error("cannot write " + details_path.string());
+  }
+  std::vector<std::string> charts = write_reproduction_charts(report, args.output);
+  std::printf("wrote %s, %s and %zu charts to %s\n", json_path.filename().c_str(),
+              details_path.filename().c_str(), charts.size(), args.output.c_str());
+  if (!report.passed()) set_command_exit_code(4);
+}
+
+}  // namespace
+
+void add_reproduce_command(CLI::App& app) {
+  auto args = std::make_shared<ReproduceArgs>();
+  CLI::App* reproduce = app.add_subcommand(
+      "reproduce", "Rerun the papers' experiments: table, charts (SVG, PNG) and JSON");
+  auto* quick = reproduce->add_flag("--quick", args->quick, "Quick mode (default; a few minutes)");
+  auto* full = reproduce->add_flag("--full", args->full, "Full mode: more trials, pixels and N");
+  quick->excludes(full);
+  reproduce->add_option("-o,--output", args->output, "Output folder for charts and JSON");
+  reproduce->add_option("--scenes", args->scenes, "Folder of the bundled scenes");
+  reproduce->add_option("--threads", args->threads, "Threads (0: all cores)")
+      ->check(CLI::Range(0, 1024));
+  reproduce->callback([args] { run_reproduce(*args); });
+}
+
+}  // namespace penumbra
