@@ -355,6 +355,27 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
   const __m128 sign_bit = _mm_set1_ps(-0.0f);
   const __m128 s_min = _mm_set1_ps(static_cast<float>(shadow->s_min));
   const __m128 s_max = _mm_set1_ps(static_cast<float>(shadow->s_max));
+  // The bounding box of the part of the shadow triangle that can hold a crossing: depth s in
+  // [s_min, s_max], the quadrilateral x + s (a - x), x + s (b - x). Box against box is the
+  // triangle-box test's box-axis half (Akenine-Möller 2001); with the free zone near x left
+  // out, it also drops the surface x lies on before its leaf is reached. Rounded outwards.
+  __m128 region_lower[3], region_upper[3];
+  {
+    const Vec3 corners[4] = {x + shadow->s_min * shadow->to_a, x + shadow->s_min * shadow->to_b,
+                             x + shadow->s_max * shadow->to_a, x + shadow->s_max * shadow->to_b};
+    for (int k = 0; k < 3; ++k) {
+      double lower = corners[0][k], upper = corners[0][k];
+      for (const Vec3& corner : corners) {
+        lower = std::min(lower, corner[k]);
+        upper = std::max(upper, corner[k]);
+      }
+      // Rounding of the corners (double) and to float (half an ulp): 1e-6 of the coordinates
+      // involved covers both.
+      double slack = 1e-6 * (std::fabs(x[k]) + std::fabs(lower) + std::fabs(upper));
+      region_lower[k] = _mm_set1_ps(static_cast<float>(lower - slack));
+      region_upper[k] = _mm_set1_ps(static_cast<float>(upper + slack));
+    }
+  }
 
   StackEntry stack[kStackCapacity];
   int top = 0;
@@ -410,6 +431,10 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
     keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, s_min));
     keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, s_max));
+    for (int k = 0; k < 3; ++k) {
+      keep = _mm_and_ps(keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), region_upper[k]));
+      keep = _mm_and_ps(keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), region_lower[k]));
+    }
     int mask = _mm_movemask_ps(keep);
     if (mask == 0) continue;
 
