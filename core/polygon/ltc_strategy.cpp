@@ -10,8 +10,8 @@ namespace penumbra {
 MaterialLtc material_ltc(const Material* material, double cos_theta_o) {
   MaterialLtc result;
   if (!material || material->type != MaterialType::Ggx) return result;
-  GgxLtc fitted = ggx_ltc(std::max(kGgxMinAlpha, material->roughness),
-                          std::clamp(cos_theta_o, 0.0, 1.0));
+  GgxLtc fitted =
+      ggx_ltc(std::max(kGgxMinAlpha, material->roughness), std::clamp(cos_theta_o, 0.0, 1.0));
   result.ltc = fitted.ltc;
   result.lobe_albedo = fitted.specular_albedo(material->specular);
   return result;

@@ -48,15 +48,14 @@ Rgb weighted_balance_weight(int j, const TechniqueDensities& pdfs,
                             const UnshadowedIntegrals& unshadowed);
 // Sec. 4.3, per channel; v in [0, 1].
 Rgb clamped_optimal_weight(int j, const TechniqueDensities& pdfs,
-                           const UnshadowedIntegrals& unshadowed,
-                           double v = kClampedOptimalBlend);
+                           const UnshadowedIntegrals& unshadowed, double v = kClampedOptimalBlend);
 // Dispatch on the heuristic (v is used by ClampedOptimal only).
 Rgb peters_mis_weight(PetersHeuristic heuristic, int j, const TechniqueDensities& pdfs,
                       const UnshadowedIntegrals& unshadowed, double v = kClampedOptimalBlend);
 
 // What one technique's sample brings to the combination.
 struct TechniqueSample {
-  Rgb integrand{0, 0, 0};  // f(x_j) = L_e f_r cos V G at the sampled point (0 if occluded)
+  Rgb integrand{0, 0, 0};         // f(x_j) = L_e f_r cos V G at the sampled point (0 if occluded)
   TechniqueDensities pdfs{0, 0};  // p_0(x_j), p_1(x_j), same measure as the integrand's
 };
 

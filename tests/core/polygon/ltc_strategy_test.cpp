@@ -3,6 +3,8 @@
 // Eq. 10) against quadrature; lambert and phong receivers give exactly psa; finite results for
 // tiny distant lights, lights crossing the horizon, points behind the light.
 
+#include "core/polygon/ltc_strategy.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -10,7 +12,6 @@
 #include <vector>
 
 #include "core/polygon/ltc_ggx_table.h"
-#include "core/polygon/ltc_strategy.h"
 #include "core/polygon/psa_strategy.h"
 #include "polygon_test_util.h"
 
@@ -57,21 +58,34 @@ std::vector<Configuration> configurations() {
   using polygon_test::quad_light;
   std::vector<Configuration> c;
   Light ceiling = quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1});
-  c.push_back({"ceiling quad, normal view, alpha 0.5", ceiling, {0.1, 0, 0.2}, {0, 1, 0},
-               {0, 1, 0}, 0.5});
-  c.push_back({"ceiling quad, oblique view, alpha 0.25", ceiling, {0.3, 0, 0}, {0, 1, 0},
-               {1, 0.8, 0.3}, 0.25});
+  c.push_back(
+      {"ceiling quad, normal view, alpha 0.5", ceiling, {0.1, 0, 0.2}, {0, 1, 0}, {0, 1, 0}, 0.5});
+  c.push_back({"ceiling quad, oblique view, alpha 0.25",
+               ceiling,
+               {0.3, 0, 0},
+               {0, 1, 0},
+               {1, 0.8, 0.3},
+               0.25});
   c.push_back({"offset quad, grazing view, alpha 0.35",
-               quad_light({0.5, 0.6, -0.5}, {1.5, 0, 0}, {0, 0, 1}), {0, 0, 0}, {0, 1, 0},
-               {-1, 0.25, 0}, 0.35});
+               quad_light({0.5, 0.6, -0.5}, {1.5, 0, 0}, {0, 0, 1}),
+               {0, 0, 0},
+               {0, 1, 0},
+               {-1, 0.25, 0},
+               0.35});
   c.push_back({"tilted triangle, alpha 0.8",
                light_facing({{0.3, 1.2, -0.4}, {1.1, 0.9, 0.2}, {-0.2, 1.4, 0.5}}, {0, 0, 0}),
-               {0, 0, 0}, {0.3, 1, -0.2}, {-0.5, 1, 0.2}, 0.8});
+               {0, 0, 0},
+               {0.3, 1, -0.2},
+               {-0.5, 1, 0.2},
+               0.8});
   c.push_back(
       {"pentagon crossing the horizon, alpha 0.3",
        light_facing({{1, 0.5, -1}, {1, 1.2, -0.6}, {1, 1.2, 0.6}, {1, 0.5, 1}, {1, -0.4, 0}},
                     {0, 0, 0}),
-       {0, 0, 0}, {-0.3, 1, 0}, {-1, 0.6, 0.1}, 0.3});
+       {0, 0, 0},
+       {-0.3, 1, 0},
+       {-1, 0.6, 0.1},
+       0.3});
   return c;
 }
 
@@ -151,8 +165,7 @@ TEST(LtcStrategy, PdfIsNormalizedAndTheLtcIntegralMatchesQuadrature) {
           Vec3 d = x - sp.position;
           double r2 = length_squared(d);
           Vec3 w = d / std::sqrt(r2);
-          return strategy.ltc().density(frame.to_local(w)) *
-                 std::abs(dot(c.light.normal, w)) / r2;
+          return strategy.ltc().density(frame.to_local(w)) * std::abs(dot(c.light.normal, w)) / r2;
         },
         600);
     EXPECT_NEAR(strategy.ltc_integral(), ltc_mass, 2e-3 * ltc_mass) << c.name;
@@ -237,7 +250,8 @@ TEST(LtcStrategy, StressConfigurationsStayFinite) {
       Vec3 center{distance * (uniform(rng) - 0.5), distance, distance * (uniform(rng) - 0.5)};
       Light light = polygon_test::quad_light(center, {side, 0, 0}, {0, 0, side});
       if (trial % 4 == 0)  // Fig. 12: edges parallel to the normal, crossing the horizon
-        light = polygon_test::quad_light({1, -0.5, -0.5}, {0, 0, 1}, {0, 1.5, 0}), normal = {0, 1, 0};
+        light = polygon_test::quad_light({1, -0.5, -0.5}, {0, 0, 1}, {0, 1.5, 0}),
+        normal = {0, 1, 0};
       Material material = ggx_material(trial % 3 == 0 ? 1e-4 : uniform(rng));
       ShadingPoint sp = shading_point({0, 0, 0}, normal, wo, &material);
       LtcStrategy ltc(sp, light);

@@ -48,8 +48,7 @@ inline double integrate_sphere(const std::function<double(const Vec3&)>& f, cons
     double weight = std::sin(theta) * 2.0 * kPi * t / theta_steps * (2.0 * kPi / phi_steps);
     for (int k = 0; k < phi_steps; ++k) {
       double phi = 2.0 * kPi * (k + 0.5) / phi_steps;
-      Vec3 local{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                 std::cos(theta)};
+      Vec3 local{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
       total += f(frame.to_world(local)) * weight;
     }
   }

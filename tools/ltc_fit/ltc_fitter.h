@@ -1,0 +1,69 @@
+#pragma once
+// Fitting linearly transformed cosines to our `ggx` specular lobe times cosine (F = 1), after
+// Heitz, Dupuy, Hill & Neubelt 2016, Sec. 4 (our own implementation of the published procedure):
+//   1. moments of the lobe by importance sampling (visible normals): its albedo, its Schlick
+//      Fresnel integral and its average direction, which becomes the z-axis of the LTC's frame;
+//   2. M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], with (m11, m22, m13) minimizing the
+//      cubed difference between the normalized lobe and the LTC density (Nelder-Mead), the
+//      integral estimated with stratified samples of both distributions combined by the balance
+//      heuristic (fixed stratum centres: the objective is a smooth, deterministic function);
+//   3. the fit error per cell: the L1 distance of the two normalized distributions.
+// Everything is deterministic (no random numbers; stratum centres only).
+
+#include <array>
+#include <functional>
+#include <vector>
+
+#include "core/math/vec.h"
+#include "core/polygon/ltc_ggx_table.h"
+
+namespace penumbra::ltc_fit {
+
+struct FitOptions {
+  int moment_samples_per_axis = 256;     // lobe moments (albedo, Fresnel, average direction)
+  int objective_samples_per_axis = 32;   // per distribution, per Nelder-Mead evaluation
+  int fit_error_samples_per_axis = 128;  // the recorded L1 fit error
+  int max_evaluations = 600;
+};
+
+// The lobe's moments for wo = (sin theta, 0, cos theta).
+struct LobeMoments {
+  double albedo = 0;
+  double fresnel = 0;
+  Vec3 average_direction{0, 0, 1};  // unit, in the xz-plane
+};
+LobeMoments ggx_lobe_moments(double alpha, double cos_theta, int samples_per_axis);
+
+// Parameters (m11, m22, m13) of M in the lobe's frame.
+using LtcParameters = std::array<double, 3>;
+Matrix3 ltc_matrix(const LtcParameters& parameters, const Vec3& average_direction);
+
+// The L1 distance integral |f cos / albedo - p_M| dw for the lobe at (alpha, cos_theta).
+double ltc_fit_error(const LinearlyTransformedCosine& ltc, double alpha, double cos_theta,
+                     double albedo, int samples_per_axis);
+
+struct CellFit {
+  GgxLtcCell cell;
+  LtcParameters parameters{};
+  int evaluations = 0;
+};
+CellFit fit_ggx_ltc_cell(double alpha, double cos_theta, const LtcParameters& initial,
+                         const FitOptions& options);
+
+// The whole table, row-major (row = roughness index), fitted from rough to smooth, each cell
+// started from its neighbour's solution (Heitz et al.). `progress` is called after each row.
+std::vector<CellFit> fit_ggx_ltc_table(const FitOptions& options,
+                                       const std::function<void(int row)>& progress = {});
+
+// Minimizes f over R^3 from `start` with the Nelder-Mead simplex method (Nelder & Mead 1965),
+// initial simplex steps `step` (relative to each |start| entry, at least `step` absolute).
+struct NelderMeadResult {
+  LtcParameters minimum{};
+  double value = 0;
+  int evaluations = 0;
+};
+NelderMeadResult nelder_mead(const std::function<double(const LtcParameters&)>& f,
+                             const LtcParameters& start, double step, int max_evaluations,
+                             double tolerance);
+
+}  // namespace penumbra::ltc_fit
