@@ -24,10 +24,10 @@ struct ShadingPoint;
 enum class LineAxis { Edge1, Edge2 };
 
 struct TracedLine {
-  double offset = 0;          // s in [0,1]
-  double horizon_lo = 0;      // the part of the line above the horizon: t in [horizon_lo,
-  double horizon_hi = 1;      // horizon_hi] (empty when lo >= hi)
-  IntervalList visible;       // visible and above the horizon, in t of the whole line
+  double offset = 0;      // s in [0,1]
+  double horizon_lo = 0;  // the part of the line above the horizon: t in [horizon_lo,
+  double horizon_hi = 1;  // horizon_hi] (empty when lo >= hi)
+  IntervalList visible;   // visible and above the horizon, in t of the whole line
 };
 
 class QuadLineFamily {
@@ -52,7 +52,7 @@ class QuadLineFamily {
   Vec3 x_, normal_;
   Vec3 origin_, along_, across_;
   double along_length_ = 0, across_length_ = 0;
-  Vec3 plane_normal_;            // along x across
+  Vec3 plane_normal_;           // along x across
   double plane_normal_sq_ = 0;  // |along x across|^2
   LineAxis axis_ = LineAxis::Edge1;
 };

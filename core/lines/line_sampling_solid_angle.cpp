@@ -29,9 +29,8 @@ HIntervals h_intervals(const SphericalRectangle& r, const SphericalRectangle::HB
 }  // namespace
 
 bool LineSolidAngleStrategy::supports(const Light& light) {
-  return light.type == LightType::Quad &&
-         std::abs(dot(light.edge1, light.edge2)) <=
-             1e-6 * length(light.edge1) * length(light.edge2);
+  return light.type == LightType::Quad && std::abs(dot(light.edge1, light.edge2)) <=
+                                              1e-6 * length(light.edge1) * length(light.edge2);
 }
 
 LineSolidAngleStrategy::LineSolidAngleStrategy(const ShadingPoint& sp, const Light& light,
@@ -84,8 +83,8 @@ std::optional<LightPoint> LineSolidAngleStrategy::sample(const Vec2& u, TracedLi
   }
   LightPoint point;
   point.position = family_->point_at(offset, t);
-  point.pdf_area = to_area(r.line_sample_solid_angle_pdf(h.line_length, h.visible_length),
-                           point.position);
+  point.pdf_area =
+      to_area(r.line_sample_solid_angle_pdf(h.line_length, h.visible_length), point.position);
   if (!(point.pdf_area > 0)) return std::nullopt;
   return point;
 }
