@@ -39,11 +39,17 @@ struct Coordinator::Job {
   JobRecord record;
   v1::StoredJob stored;
   uint64_t tile_count = 0;
-  std::vector<TileRect> tiles;                  // empty once the job ended
-  std::shared_ptr<const Scene> scene;           // null once the job ended
-  uint32_t total_blocks = 0;                    // spp budget; seconds budget: the most it may open
-  std::vector<TileAccumulator> sealed;          // per tile, blocks [0, blocks_sealed)
-  std::map<uint64_t, TileAccumulator> pending;  // completed tasks of unsealed blocks
+  std::vector<TileRect> tiles;          // empty once the job ended
+  std::shared_ptr<const Scene> scene;   // null once the job ended
+  uint32_t total_blocks = 0;            // spp budget; seconds budget: the most it may open
+  std::vector<TileAccumulator> sealed;  // per tile, blocks [0, blocks_sealed)
+  struct PendingResult {
+    TileAccumulator tile;
+    double compute_seconds = 0;
+    bool durable = false;  // written to the store (only durable results are sealed)
+  };
+  std::map<uint64_t, PendingResult> pending;  // completed tasks of unsealed blocks
+  double sealed_compute_seconds = 0;          // of the tasks merged into `sealed`
   std::map<uint64_t, int> failures;
   uint64_t tasks_completed_ever = 0;  // for the average task cost (seconds budgets)
   double task_seconds_ever = 0;
@@ -115,6 +121,7 @@ void Coordinator::resume(const JobRecord& record) {
     j.mrse = j.curve.back().mrse;
   }
   if (is_terminal(record.state)) return;
+  j.sealed_compute_seconds = record.compute_seconds;  // the store keeps the sealed blocks' share
 
   try {
     auto package = store_.scene(j.spec().scene_hash());
@@ -131,7 +138,10 @@ void Coordinator::resume(const JobRecord& record) {
                                             : TileAccumulator::deserialize(it->second));
     }
     for (TaskResultRecord& result : store_.task_results(record.id)) {
-      j.pending.emplace(result.task_index, TileAccumulator::deserialize(result.tile));
+      j.pending.emplace(result.task_index,
+                        Job::PendingResult{TileAccumulator::deserialize(result.tile),
+                                           result.compute_seconds, true});
+      j.record.compute_seconds += result.compute_seconds;
       j.record.blocks_opened = std::max<uint32_t>(j.record.blocks_opened,
                                                   uint32_t(result.task_index / j.tile_count) + 1);
     }
@@ -358,10 +368,13 @@ void Coordinator::seal_ready_blocks(Job& job) {
     auto begin_it = job.pending.lower_bound(first);
     auto end_it = job.pending.lower_bound(end);
     if (uint64_t(std::distance(begin_it, end_it)) != job.tile_count) break;
+    if (!std::all_of(begin_it, end_it, [](const auto& entry) { return entry.second.durable; }))
+      break;
     std::map<uint32_t, std::string> tiles;
     for (auto it = begin_it; it != end_it; ++it) {
       uint32_t tile = uint32_t(it->first - first);
-      job.sealed[tile].merge(it->second);
+      job.sealed[tile].merge(it->second.tile);
+      job.sealed_compute_seconds += it->second.compute_seconds;
       tiles[tile] = job.sealed[tile].serialize();
     }
     job.pending.erase(begin_it, end_it);
@@ -385,7 +398,9 @@ void Coordinator::seal_ready_blocks(Job& job) {
         spdlog::warn("{}: no MRSE: {}", job_name(job.record.id), error.what());
       }
     }
-    store_.seal_block(job.record, tiles, first, end, point);
+    JobRecord durable = job.record;
+    durable.compute_seconds = job.sealed_compute_seconds;
+    store_.seal_block(durable, tiles, first, end, point);
     spdlog::debug("{}: {} passes sealed", job_name(job.record.id), passes);
   }
   maybe_open_block(job);
@@ -731,27 +746,27 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
   }
   if (!std::isfinite(request.compute_seconds()) || request.compute_seconds() < 0)
     throw invalid("compute_seconds: must be finite and not negative");
-  Notifications notifications;
+  uint64_t job_id = 0;
+  try {
+    job_id = parse_job_id(request.job_id());
+  } catch (const FarmError&) {
+    return false;
+  }
+  const uint64_t task_index = request.task_index();
   {
     std::lock_guard lock(mutex_);
     const Lease* lease = leases_.find(request.attempt_token());
-    uint64_t job_id = 0;
-    try {
-      job_id = parse_job_id(request.job_id());
-    } catch (const FarmError&) {
-      return false;
-    }
-    if (!lease || lease->task.job_id != job_id || lease->task.task_index != request.task_index()) {
+    if (!lease || lease->task.job_id != job_id || lease->task.task_index != task_index) {
       spdlog::debug("{} task {}: late or duplicate result from {} dropped", request.job_id(),
-                    request.task_index(), request.worker_id());
+                    task_index, request.worker_id());
       return false;
     }
     Job& job = *jobs_.at(job_id);
-    TileRect rect = task_tile(job, request.task_index());
-    auto [pass_begin, pass_end] = task_passes(job, request.task_index());
+    TileRect rect = task_tile(job, task_index);
+    auto [pass_begin, pass_end] = task_passes(job, task_index);
     if (!(tile.rect() == rect))
       throw invalid("tile: the result's rectangle does not match task " +
-                    std::to_string(request.task_index()));
+                    std::to_string(task_index));
     for (int64_t i = 0; i < rect.pixel_count(); ++i)
       if (tile.count(i) != pass_end - pass_begin)
         throw invalid("tile: pixel " + std::to_string(i) + " has " + std::to_string(tile.count(i)) +
@@ -767,10 +782,32 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
     ++job.tasks_completed_ever;
     job.task_seconds_ever += request.compute_seconds();
     if (!job.record.started_unix_ms) job.record.started_unix_ms = unix_ms();
-    store_.add_task_result(job.record,
-                           {request.task_index(), request.tile(), request.compute_seconds()});
-    job.pending.emplace(request.task_index(), std::move(tile));
-    seal_ready_blocks(job);
+    job.pending.emplace(task_index,
+                        Job::PendingResult{std::move(tile), request.compute_seconds(), false});
+  }
+  // The durable write happens outside the lock, so that concurrent completions share one
+  // transaction (Store::add_task_result commits them as a group).
+  try {
+    store_.add_task_result(job_id, {task_index, request.tile(), request.compute_seconds()});
+  } catch (const std::exception& error) {
+    std::lock_guard lock(mutex_);
+    Job& job = *jobs_.at(job_id);
+    if (!is_terminal(job.record.state) && job.pending.erase(task_index)) {
+      job.record.compute_seconds -= request.compute_seconds();
+      scheduler_.requeue({job_id, task_index});
+    }
+    throw FarmError(FarmErrorCode::Internal,
+                    std::string("cannot store the result: ") + error.what());
+  }
+  Notifications notifications;
+  {
+    std::lock_guard lock(mutex_);
+    Job& job = *jobs_.at(job_id);
+    auto it = job.pending.find(task_index);
+    if (!is_terminal(job.record.state) && it != job.pending.end()) {
+      it->second.durable = true;
+      seal_ready_blocks(job);
+    }
     collect_notifications(job_id, notifications);
   }
   run(notifications);

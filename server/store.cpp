@@ -212,19 +212,52 @@ std::vector<JobRecord> Store::jobs() {
   return jobs;
 }
 
-void Store::add_task_result(const JobRecord& job, const TaskResultRecord& result) {
-  std::lock_guard lock(mutex_);
-  Transaction transaction(*this);
-  Statement(db_,
-            "INSERT OR REPLACE INTO task_results (job_id, task_index, tile, compute_seconds) "
-            "VALUES (?, ?, ?, ?)")
-      .bind(1, int64_t(job.id))
-      .bind(2, int64_t(result.task_index))
-      .bind_blob(3, result.tile)
-      .bind(4, result.compute_seconds)
-      .run();
-  write_job_fields(job);
-  transaction.commit();
+void Store::add_task_result(uint64_t job_id, const TaskResultRecord& result) {
+  std::unique_lock lock(group_mutex_);
+  group_queue_.push_back({job_id, result});
+  const uint64_t ticket = ++group_enqueued_;
+  while (group_committed_ < ticket) {
+    if (group_writing_) {
+      group_done_.wait(lock);
+      continue;
+    }
+    // This caller leads: it writes everything queued so far in one transaction.
+    group_writing_ = true;
+    std::vector<QueuedResult> batch;
+    batch.swap(group_queue_);
+    const uint64_t first = group_committed_ + 1, last = group_enqueued_;
+    lock.unlock();
+    std::exception_ptr error;
+    try {
+      std::lock_guard connection(mutex_);
+      Transaction transaction(*this);
+      Statement insert(db_,
+                       "INSERT OR REPLACE INTO task_results (job_id, task_index, tile, "
+                       "compute_seconds) VALUES (?, ?, ?, ?)");
+      for (const QueuedResult& queued : batch) {
+        insert.bind(1, int64_t(queued.job_id))
+            .bind(2, int64_t(queued.result.task_index))
+            .bind_blob(3, queued.result.tile)
+            .bind(4, queued.result.compute_seconds)
+            .run();
+        insert.reset();
+      }
+      transaction.commit();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    lock.lock();
+    if (error) {
+      group_failures_.push_back({first, last, error});
+      if (group_failures_.size() > 64) group_failures_.erase(group_failures_.begin());
+    }
+    group_committed_ = last;
+    group_writing_ = false;
+    group_done_.notify_all();
+  }
+  for (const FailedBatch& failed : group_failures_)
+    if (ticket >= failed.first_ticket && ticket <= failed.last_ticket)
+      std::rethrow_exception(failed.error);
 }
 
 std::vector<TaskResultRecord> Store::task_results(uint64_t job_id) {

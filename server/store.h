@@ -8,7 +8,9 @@
 
 #include <sqlite3.h>
 
+#include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -28,8 +30,8 @@ struct JobRecord {
   int64_t finished_unix_ms = 0;
   uint32_t blocks_opened = 0;  // pass blocks whose tasks exist
   uint32_t blocks_sealed = 0;  // pass blocks every tile has completed
-  double compute_seconds = 0;
-  std::string final_errors;  // serialized errors against the reference (opaque)
+  double compute_seconds = 0;  // stored: of the sealed blocks (task results hold the rest)
+  std::string final_errors;    // serialized errors against the reference (opaque)
 };
 
 struct TaskResultRecord {
@@ -63,9 +65,9 @@ class Store {
   void update_job(const JobRecord& job);
   std::vector<JobRecord> jobs();
 
-  // Records a completed task and its share of the job's compute seconds, with the job's updated
-  // fields, in one transaction.
-  void add_task_result(const JobRecord& job, const TaskResultRecord& result);
+  // Records a completed task durably. Concurrent callers are committed together in one
+  // transaction (group commit): each call returns once its own record is on disk.
+  void add_task_result(uint64_t job_id, const TaskResultRecord& result);
   std::vector<TaskResultRecord> task_results(uint64_t job_id);
 
   // Seals a pass block: replaces the job's tile sums with `tiles` (tile index -> serialized
@@ -89,7 +91,23 @@ class Store {
   void execute(const char* sql);
   void write_job_fields(const JobRecord& job);
 
-  std::mutex mutex_;
+  struct QueuedResult {
+    uint64_t job_id;
+    TaskResultRecord result;
+  };
+  struct FailedBatch {
+    uint64_t first_ticket, last_ticket;
+    std::exception_ptr error;
+  };
+
+  std::mutex mutex_;  // the connection
+  // Group commit of task results.
+  std::mutex group_mutex_;
+  std::condition_variable group_done_;
+  std::vector<QueuedResult> group_queue_;
+  uint64_t group_enqueued_ = 0, group_committed_ = 0;
+  bool group_writing_ = false;
+  std::vector<FailedBatch> group_failures_;
   sqlite3* db_ = nullptr;
   std::string path_;
 };

@@ -204,6 +204,7 @@ TEST_F(CoordinatorTest, RestartKeepsSealedBlocksAndCompletedTasks) {
   v1::JobStatus status = coordinator->status(job);
   EXPECT_EQ(status.passes_complete(), 4u);
   EXPECT_EQ(status.tasks_complete(), 8u);
+  EXPECT_NEAR(status.compute_seconds(), 0.08, 1e-9) << "compute seconds lost in the restart";
   EXPECT_EQ(status.state(), v1::JOB_STATE_RUNNING);
   std::string worker = register_worker(*coordinator, "w");
   std::vector<v1::Task> tasks = lease(*coordinator, worker, 100);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <thread>
 
 namespace penumbra::farm {
 namespace {
@@ -29,8 +30,9 @@ TEST(Store, JobsScenesAndResultsSurviveReopening) {
     EXPECT_EQ(store.add_job(job), job.id + 1);
     job.blocks_opened = 4;
     job.compute_seconds = 2.5;
-    store.add_task_result(job, {17, "tile-17", 0.5});
-    store.add_task_result(job, {18, "tile-18", 0.25});
+    store.update_job(job);
+    store.add_task_result(job.id, {17, "tile-17", 0.5});
+    store.add_task_result(job.id, {18, "tile-18", 0.25});
     job.state = 3;
     store.finish_job(job, "exr-bytes");
   }
@@ -60,7 +62,7 @@ TEST(Store, SealingReplacesTaskResultsWithTileSums) {
   Store store(dir);
   JobRecord job;
   job.id = store.add_job(job);
-  for (uint64_t task = 0; task < 6; ++task) store.add_task_result(job, {task, "r", 0.1});
+  for (uint64_t task = 0; task < 6; ++task) store.add_task_result(job.id, {task, "r", 0.1});
   job.blocks_sealed = 1;
   store.seal_block(job, {{0, "sum0"}, {1, "sum1"}, {2, "sum2"}}, 0, 3,
                    CurvePoint{8, 1.5, 2.0, 0.25});
@@ -80,6 +82,30 @@ TEST(Store, SealingReplacesTaskResultsWithTileSums) {
   EXPECT_EQ(store.jobs()[0].blocks_sealed, 1u);
   store.drop_work(job);
   EXPECT_TRUE(store.tiles(job.id).empty());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Store, ConcurrentTaskResultsAreAllCommitted) {
+  std::string dir = fresh_dir("group");
+  Store store(dir);
+  JobRecord job;
+  job.id = store.add_job(job);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t)
+    threads.emplace_back([&, t] {
+      for (uint64_t i = 0; i < 50; ++i)
+        store.add_task_result(job.id,
+                              {uint64_t(t) * 1000 + i, std::string(100, char('a' + t)), 0.5});
+    });
+  for (auto& thread : threads) thread.join();
+  auto results = store.task_results(job.id);
+  ASSERT_EQ(results.size(), 400u);
+  double seconds = 0;
+  for (const auto& result : results) {
+    seconds += result.compute_seconds;
+    EXPECT_EQ(result.tile, std::string(100, char('a' + result.task_index / 1000)));
+  }
+  EXPECT_DOUBLE_EQ(seconds, 200.0);
   std::filesystem::remove_all(dir);
 }
 
