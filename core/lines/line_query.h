@@ -8,11 +8,12 @@
 //   structure-of-arrays, and leaf triangles stored contiguously in leaf order (float vertices
 //   in canonical order, OccluderTriangle);
 // - our own traversal: the four child boxes of a node are tested together (SSE) against the
-//   shadow triangle's plane, its three side planes and the self-occlusion plane near x, with a
-//   conservative float error bound; each surviving child's box is projected from x onto the
-//   segment and skipped when that t-range is already occluded (checked again when it is
-//   popped); children are visited nearest to x first (near occluders cut the most); the query
-//   stops as soon as nothing stays visible;
+//   shadow triangle's plane, its three side planes, the self-occlusion plane near x and the
+//   bounding box of the region that can hold a crossing, with a conservative float error
+//   bound; each surviving child's box is projected from x onto the segment and skipped when
+//   that t-range is already occluded (checked when it is popped); children are visited
+//   nearest to x first (near occluders cut the most); the query stops as soon as nothing
+//   stays visible;
 // - exact double-precision crossings at the leaves (core/lines/shadow_triangle.h), watertight
 //   at shared edges, so the result equals visible_intervals_brute_force.
 //
