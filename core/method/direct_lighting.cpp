@@ -1,11 +1,16 @@
 #include "core/method/direct_lighting.h"
 
+#include <algorithm>
 #include <new>
+#include <stdexcept>
 #include <type_traits>
 #include <variant>
 
 #include "core/lights/light_geometry.h"
+#include "core/lines/line_sampling_area.h"
+#include "core/lines/line_sampling_solid_angle.h"
 #include "core/materials/bsdf.h"
+#include "core/method/smoothing.h"
 #include "core/polygon/psa_strategy.h"
 #include "core/strategies/area_strategy.h"
 #include "core/strategies/bsdf_strategy.h"
@@ -16,14 +21,22 @@ namespace penumbra {
 namespace {
 
 // monostate: not prepared (never sampled or evaluated).
-using PreparedStrategy = std::variant<std::monostate, AreaStrategy, SolidAngleStrategy, BsdfStrategy,
-                                      ProjectedSolidAngleStrategy>;
+using PreparedStrategy =
+    std::variant<std::monostate, AreaStrategy, SolidAngleStrategy, BsdfStrategy,
+                 ProjectedSolidAngleStrategy, LineAreaStrategy, LineSolidAngleStrategy>;
+
+template <typename T>
+constexpr bool is_line_type =
+    std::is_same_v<T, LineAreaStrategy> || std::is_same_v<T, LineSolidAngleStrategy>;
 
 std::optional<LightPoint> sample_strategy(const PreparedStrategy& strategy, const Vec2& u) {
   return std::visit(
       [&](const auto& s) -> std::optional<LightPoint> {
-        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, std::monostate>) return std::nullopt;
-        else return s.sample(u);
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, std::monostate> || is_line_type<T>)
+          return std::nullopt;
+        else
+          return s.sample(u);
       },
       strategy);
 }
@@ -31,26 +44,67 @@ std::optional<LightPoint> sample_strategy(const PreparedStrategy& strategy, cons
 double pdf_strategy(const PreparedStrategy& strategy, const Vec3& point) {
   return std::visit(
       [&](const auto& s) -> double {
-        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, std::monostate>) return 0.0;
-        else return s.pdf(point);
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, std::monostate> || is_line_type<T>)
+          return 0.0;
+        else
+          return s.pdf(point);
       },
       strategy);
 }
 
-PreparedStrategy prepare(StrategyKind kind, const ShadingPoint& sp, const Light& light) {
-  switch (kind) {
-    case StrategyKind::Area: return AreaStrategy(sp, light);
-    case StrategyKind::SolidAngle: return SolidAngleStrategy(sp, light);
-    case StrategyKind::Bsdf: return BsdfStrategy(sp, light);
-    case StrategyKind::ProjectedSolidAngle: return ProjectedSolidAngleStrategy(sp, light);
-    default: break;
+LineAxis line_axis(LineDirection direction) {
+  return direction == LineDirection::V ? LineAxis::Edge2 : LineAxis::Edge1;
+}
+
+// The line of a line term's sample, or the pdf of a line term given the traced line through a
+// point (its own direction's line) and the point's t on it.
+std::optional<LightPoint> sample_line(const PreparedStrategy& strategy, const Vec2& u,
+                                      TracedLine& line, double& t) {
+  if (const auto* s = std::get_if<LineAreaStrategy>(&strategy)) return s->sample(u, line, t);
+  if (const auto* s = std::get_if<LineSolidAngleStrategy>(&strategy)) return s->sample(u, line, t);
+  return std::nullopt;
+}
+double pdf_line(const PreparedStrategy& strategy, const TracedLine& line, double t,
+                const Vec3& point) {
+  if (const auto* s = std::get_if<LineAreaStrategy>(&strategy)) return s->pdf(line, t);
+  if (const auto* s = std::get_if<LineSolidAngleStrategy>(&strategy)) return s->pdf(line, t, point);
+  return 0;
+}
+
+PreparedStrategy prepare(const MethodTerm& term, const ShadingPoint& sp, const Light& light,
+                         const LineQuery* lines) {
+  switch (term.strategy) {
+    case StrategyKind::LineArea:
+      if (lines) return LineAreaStrategy(sp, light, line_axis(term.direction), *lines);
+      break;
+    case StrategyKind::LineSolidAngle:
+      if (lines) return LineSolidAngleStrategy(sp, light, line_axis(term.direction), *lines);
+      break;
+    default:
+      break;
+  }
+  switch (term.strategy) {
+    case StrategyKind::Area:
+      return AreaStrategy(sp, light);
+    case StrategyKind::SolidAngle:
+      return SolidAngleStrategy(sp, light);
+    case StrategyKind::Bsdf:
+      return BsdfStrategy(sp, light);
+    case StrategyKind::ProjectedSolidAngle:
+      return ProjectedSolidAngleStrategy(sp, light);
+    default:
+      break;
   }
   // The constructor of DirectLighting refuses every other kind before we get here.
   return std::monostate{};
 }
 
 // Aspect of the 2D strata: strategies that map u.x along edge1 and u.y along edge2 of a quad.
+// Line terms put the line's offset in u.x: one stratum per line across x (1D stratified
+// offsets, Billen & Dutre Sec. 6), the point along the line in u.y.
 double strata_aspect(StrategyKind kind, const Light& light) {
+  if (is_line_strategy(kind)) return 1e18;
   if (light.type != LightType::Quad) return 1.0;
   if (kind != StrategyKind::Area && kind != StrategyKind::SolidAngle) return 1.0;
   double e1 = length(light.edge1), e2 = length(light.edge2);
@@ -93,7 +147,8 @@ double weight_of(Combine combine, int term, std::span<const double> scaled_pdfs)
   int terms = int(scaled_pdfs.size());
   if (terms == 1) return 1.0;
   switch (combine) {
-    case Combine::Avg: return 1.0 / terms;
+    case Combine::Avg:
+      return 1.0 / terms;
     case Combine::Power: {
       double sum = 0;
       for (double p : scaled_pdfs) sum += p * p;
@@ -138,15 +193,160 @@ class PreparedTerms {
   throw FormatError("method", "\"" + to_string(method) + "\": " + why);
 }
 
+std::string_view light_type_name(LightType type) {
+  switch (type) {
+    case LightType::Quad:
+      return "quad";
+    case LightType::Polygon:
+      return "polygon";
+    case LightType::Disk:
+      return "disk";
+  }
+  return "light";
+}
+
+bool smoothing(Combine combine) {
+  return combine == Combine::Smooth || combine == Combine::SmoothFixed;
+}
+
+// What the combination needs of one (shading point, light) beyond the prepared terms: the line
+// families along both edges (to find the line through a point, and its coordinates for the
+// smoothing heuristic) and the smoothing width d_m.
+struct LightLines {
+  std::optional<QuadLineFamily> family[2];  // by LineAxis
+  bool needed[2] = {false, false};          // some line term runs along this axis
+  double smoothing_width = 0;               // d_m: half the light's smallest side
+};
+
+// The lines through one point of the light, traced on demand and shared by the terms along the
+// same axis (a line-area and a line-sa term along edge1 see the same segment).
+class PointLines {
+ public:
+  void reset() { traced_[0] = traced_[1] = false; }
+  // Slot for a line term's own sample: it fills the line and t, then marks it.
+  TracedLine& slot(LineAxis axis) { return line_[int(axis)]; }
+  double& slot_t(LineAxis axis) { return t_[int(axis)]; }
+  void mark(LineAxis axis) { traced_[int(axis)] = true; }
+
+  // The traced line along `axis` through `point` (one line query the first time).
+  const TracedLine& get(LineAxis axis, const Vec3& point, const QuadLineFamily& family,
+                        const LineQuery& query, double& t) {
+    int a = int(axis);
+    if (!traced_[a]) {
+      Vec2 st = family.coordinates(point);
+      t_[a] = std::clamp(st.y, 0.0, 1.0);
+      if (st.x >= -1e-9 && st.x <= 1 + 1e-9 && st.y >= -1e-9 && st.y <= 1 + 1e-9) {
+        family.trace(std::clamp(st.x, 0.0, 1.0), query, line_[a]);
+      } else {
+        line_[a].offset = st.x;
+        line_[a].visible.clear();
+      }
+      traced_[a] = true;
+    }
+    t = t_[a];
+    return line_[a];
+  }
+
+ private:
+  TracedLine line_[2];
+  double t_[2] = {0, 0};
+  bool traced_[2] = {false, false};
+};
+
+// The combination weight of a sample of term `term` at `point` (its own pdf `own_pdf`).
+double combination_weight(const MethodSpec& method, const PreparedTerms& prepared,
+                          const LightLines& lines, PointLines& point_lines, const LineQuery* query,
+                          size_t term, double own_pdf, const Vec3& point, int multiplier) {
+  const size_t term_count = method.terms.size();
+  if (term_count == 1) return 1.0;
+  if (method.combine == Combine::Avg) return 1.0 / double(term_count);
+  double scaled[kMaxMethodTerms];
+  for (size_t k = 0; k < term_count; ++k) {
+    const MethodTerm& other = method.terms[k];
+    double pdf;
+    if (k == term) {
+      pdf = own_pdf;
+    } else if (is_line_strategy(other.strategy)) {
+      LineAxis axis = line_axis(other.direction);
+      const auto& family = lines.family[int(axis)];
+      pdf = 0;
+      if (family && query) {
+        double t;
+        const TracedLine& line = point_lines.get(axis, point, *family, *query, t);
+        pdf = pdf_line(prepared[k], line, t, point);
+      }
+    } else {
+      pdf = pdf_strategy(prepared[k], point);
+    }
+    scaled[k] = double(other.count) * multiplier * pdf;
+  }
+  std::span<const double> plain(scaled, term_count);
+  if (!smoothing(method.combine)) return weight_of(method.combine, int(term), plain);
+
+  // Salesin & Jarosz Eq. 22-24: ease the BSDF terms' pdfs to 0 at discontinuities.
+  const auto& along_edge1 = lines.family[int(LineAxis::Edge1)];
+  double factor = 1.0;
+  if (along_edge1) {
+    Vec2 st = along_edge1->coordinates(point);  // (fraction along edge2, fraction along edge1)
+    double side1 = along_edge1->along_length(), side2 = along_edge1->across_length();
+    factor = light_edge_smoothing(st.y * side1, side1, lines.smoothing_width) *
+             light_edge_smoothing(st.x * side2, side2, lines.smoothing_width);
+    if (method.combine == Combine::Smooth && query) {
+      for (int a = 0; a < 2 && factor > 0; ++a) {
+        if (!lines.needed[a] || !lines.family[a]) continue;
+        double t;
+        const TracedLine& line = point_lines.get(LineAxis(a), point, *lines.family[a], *query, t);
+        factor *= occluder_edge_smoothing(line, t, lines.family[a]->along_length(),
+                                          lines.smoothing_width);
+      }
+    }
+  }
+  double smoothed[kMaxMethodTerms];
+  double sum = 0;
+  for (size_t k = 0; k < term_count; ++k) {
+    smoothed[k] = method.terms[k].strategy == StrategyKind::Bsdf ? scaled[k] * factor : scaled[k];
+    sum += smoothed[k];
+  }
+  // Where every smoothed pdf vanishes (only BSDF terms, at an edge) the plain balance heuristic
+  // keeps the weights summing to one.
+  if (!(sum > 0)) return weight_of(Combine::Balance, int(term), plain);
+  return smoothed[term] / sum;
+}
+
+LightLines prepare_light_lines(const MethodSpec& method, const ShadingPoint& sp,
+                               const Light& light) {
+  LightLines lines;
+  bool any = smoothing(method.combine);
+  for (const MethodTerm& term : method.terms) {
+    if (!is_line_strategy(term.strategy)) continue;
+    lines.needed[int(line_axis(term.direction))] = true;
+    any = true;
+  }
+  if (!any || light.type != LightType::Quad) return lines;
+  for (int a = 0; a < 2; ++a)
+    if (lines.needed[a] || (a == 0 && smoothing(method.combine)))
+      lines.family[a] = QuadLineFamily::prepare(sp.position, sp.normal, light, LineAxis(a));
+  lines.smoothing_width = 0.5 * std::min(length(light.edge1), length(light.edge2));
+  return lines;
+}
+
 }  // namespace
 
 DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
     : scene_(&scene), method_(method) {
+  auto refuse_non_quads = [&](std::string_view what, std::string_view why) {
+    for (size_t l = 0; l < scene.lights.size(); ++l)
+      if (scene.lights[l].type != LightType::Quad)
+        refuse(method, std::string(what) + " " + std::string(why) + "; light " + std::to_string(l) +
+                           " is a " + std::string(light_type_name(scene.lights[l].type)));
+  };
   for (const MethodTerm& term : method.terms) {
+    std::string name(strategy_name(term.strategy));
     switch (term.strategy) {
       case StrategyKind::Area:
       case StrategyKind::SolidAngle:
-      case StrategyKind::Bsdf: break;
+      case StrategyKind::Bsdf:
+        break;
       case StrategyKind::ProjectedSolidAngle:
         for (size_t l = 0; l < scene.lights.size(); ++l)
           if (scene.lights[l].type == LightType::Disk)
@@ -154,44 +354,96 @@ DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
                                std::to_string(l) + " is a disk (use sa or area)");
         break;
       case StrategyKind::Ltc:
-        refuse(method, "strategy \"" + std::string(strategy_name(term.strategy)) +
+        refuse(method, "strategy \"" + name +
                            "\" is not available yet (Peters 2021 LTC sampling, issue #4)");
       case StrategyKind::LineArea:
       case StrategyKind::LineSolidAngle:
+        if (term.direction == LineDirection::Rand)
+          refuse(method, "strategy \"" + name +
+                             ":rand\" is not defined: a random line direction per shading point "
+                             "has no closed-form pdf at a point (MIS and Salesin & Jarosz's point "
+                             "interpretation need it), and Ureña's parametrization follows the "
+                             "light's edges; use :u or :v");
+        refuse_non_quads("strategy \"" + name + "\"",
+                         "samples lines of quad lights (along edge1 or edge2)");
+        if (term.strategy == StrategyKind::LineSolidAngle) {
+          for (size_t l = 0; l < scene.lights.size(); ++l)
+            if (!LineSolidAngleStrategy::supports(scene.lights[l]))
+              refuse(method,
+                     "strategy \"line-sa\" needs a rectangular light (Ureña et al.'s "
+                     "spherical rectangle); light " +
+                         std::to_string(l) +
+                         " is a parallelogram whose edges are not perpendicular (to 1e-6 "
+                         "relative): use line-area");
+        }
+        break;
       case StrategyKind::LineBd16:
-        refuse(method, "strategy \"" + std::string(strategy_name(term.strategy)) +
-                           "\" is not available yet (line samples, issue #3)");
+        refuse(method, "strategy \"" + name +
+                           "\" is not available yet (Billen & Dutré's analytic lines, issue #3)");
     }
   }
   switch (method.combine) {
     case Combine::Balance:
     case Combine::Power:
-    case Combine::Avg: break;
+    case Combine::Avg:
+      break;
+    case Combine::Smooth:
+    case Combine::SmoothFixed:
+      refuse_non_quads("combination \"" + std::string(combine_name(method.combine)) + "\"",
+                       "smooths the BSDF pdf over a quad's (u, v) (Salesin & Jarosz Eq. 23)");
+      break;
     default:
       refuse(method, "combination \"" + std::string(combine_name(method.combine)) +
                          "\" is not available yet");
   }
 }
 
+bool DirectLighting::needs_line_query() const {
+  for (const MethodTerm& term : method_.terms)
+    if (is_line_strategy(term.strategy)) return true;
+  return false;
+}
+
 std::vector<double> DirectLighting::weights(const ShadingPoint& sp, int light_index,
-                                            const Vec3& light_point, int multiplier) const {
+                                            const Vec3& light_point, int multiplier,
+                                            const LineQuery* query) const {
   const Light& light = scene_->lights[light_index];
   size_t terms = method_.terms.size();
-  std::vector<double> scaled(terms);
-  for (size_t k = 0; k < terms; ++k) {
-    PreparedStrategy strategy = prepare(method_.terms[k].strategy, sp, light);
-    double pdf = pdf_strategy(strategy, light_point);
-    scaled[k] = double(method_.terms[k].count) * multiplier * pdf;
-  }
+  PreparedTerms prepared;
+  for (size_t k = 0; k < terms; ++k)
+    prepared.emplace_back(prepare(method_.terms[k], sp, light, query));
+  LightLines lines = prepare_light_lines(method_, sp, light);
   std::vector<double> out(terms);
-  for (size_t k = 0; k < terms; ++k) out[k] = weight_of(method_.combine, int(k), scaled);
+  for (size_t i = 0; i < terms; ++i) {
+    // Term i's own pdf at the point, as another term would evaluate it.
+    PointLines point_lines;
+    double own;
+    if (is_line_strategy(method_.terms[i].strategy)) {
+      own = 0;
+      LineAxis axis = line_axis(method_.terms[i].direction);
+      if (lines.family[int(axis)] && query) {
+        double t;
+        const TracedLine& line =
+            point_lines.get(axis, light_point, *lines.family[int(axis)], *query, t);
+        own = pdf_line(prepared[i], line, t, light_point);
+      }
+    } else {
+      own = pdf_strategy(prepared[i], light_point);
+    }
+    out[i] = combination_weight(method_, prepared, lines, point_lines, query, i, own, light_point,
+                                multiplier);
+  }
   return out;
 }
 
-Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibility,
-                             Pattern pattern, const StreamKey& key, int multiplier) const {
+Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibility, Pattern pattern,
+                             const StreamKey& key, int multiplier) const {
   thread_local std::vector<Vec2> samples;
-  constexpr int kMaxTerms = kMaxMethodTerms;
+  thread_local PointLines point_lines;
+  const LineQuery* query = visibility.line_query();
+  if (!query && needs_line_query())
+    throw std::invalid_argument("DirectLighting: method \"" + to_string(method_) +
+                                "\" has line terms but the Visibility has no line query");
   Rgb total;
   const size_t term_count = method_.terms.size();
   for (size_t l = 0; l < scene_->lights.size(); ++l) {
@@ -201,11 +453,14 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
     // Prepare every term's strategy once for this shading point and light.
     PreparedTerms prepared;
     for (size_t k = 0; k < term_count; ++k)
-      prepared.emplace_back(prepare(method_.terms[k].strategy, sp, light));
+      prepared.emplace_back(prepare(method_.terms[k], sp, light, query));
+    LightLines lines = prepare_light_lines(method_, sp, light);
 
     Rgb light_sum;
     for (size_t i = 0; i < term_count; ++i) {
       const MethodTerm& term = method_.terms[i];
+      const bool line_term = is_line_strategy(term.strategy);
+      const LineAxis axis = line_axis(term.direction);
       const int n = term.count * multiplier;
       samples.resize(n);
       StreamKey stream = key;
@@ -213,22 +468,25 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
       generate_2d(pattern, stream, strata_aspect(term.strategy, light), samples);
 
       for (int j = 0; j < n; ++j) {
-        std::optional<LightPoint> x = sample_strategy(prepared[i], samples[j]);
+        point_lines.reset();
+        std::optional<LightPoint> x;
+        if (line_term) {
+          x = sample_line(prepared[i], samples[j], point_lines.slot(axis),
+                          point_lines.slot_t(axis));
+          point_lines.mark(axis);
+        } else {
+          x = sample_strategy(prepared[i], samples[j]);
+        }
         if (!x || !(x->pdf_area > 0)) continue;
         Rgb f = unshadowed_integrand(sp, light, x->position);
         if (is_black(f)) continue;
+        // A line sample's point is visible by construction; other samples take a shadow ray
+        // before any line pdf is evaluated (only visible points need one).
+        if (!line_term && visibility.occluded(sp.position, sp.normal, x->position)) continue;
 
-        double weight = 1.0;
-        if (term_count > 1) {
-          double scaled[kMaxTerms];
-          for (size_t k = 0; k < term_count; ++k) {
-            double pdf = k == i ? x->pdf_area : pdf_strategy(prepared[k], x->position);
-            scaled[k] = double(method_.terms[k].count) * multiplier * pdf;
-          }
-          weight = weight_of(method_.combine, int(i), std::span<const double>(scaled, term_count));
-          if (weight == 0) continue;
-        }
-        if (visibility.occluded(sp.position, sp.normal, x->position)) continue;
+        double weight = combination_weight(method_, prepared, lines, point_lines, query, i,
+                                           x->pdf_area, x->position, multiplier);
+        if (weight == 0) continue;
         Rgb contribution = f * (weight / (double(n) * x->pdf_area));
         if (is_finite(contribution)) light_sum += contribution;
       }

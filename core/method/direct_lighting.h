@@ -8,6 +8,14 @@
 //   balance  w_i = n_i p_i / sum_k n_k p_k
 //   power    w_i = (n_i p_i)^2 / sum_k (n_k p_k)^2            (Veach's beta = 2)
 //   avg      w_i = 1 / T                                        (plain average of the T estimates)
+//   smooth-fixed, smooth: balance with the BSDF terms' pdfs eased to 0 at the light's edges
+//            (and, for smooth, at occluder edges found by the method's line terms): Salesin &
+//            Jarosz Eq. 22-24, core/method/smoothing.h. Quad lights only.
+//
+// Line terms (`line-area`, `line-sa` with direction u or v; core/lines/line_sampling_*.h) need
+// the Visibility's line query: their own samples are visible by construction (no shadow ray), and
+// their pdf at another term's sample takes one line query through that point, made only for
+// visible points with nonzero integrand (one per line direction, shared by the terms along it).
 
 #include <vector>
 
@@ -34,8 +42,12 @@ class DirectLighting {
 
   // The combination weights of a point on `light_index` drawn by `term`, for tests: the weights
   // of all terms at the same point sum to one wherever some pdf is nonzero.
+  // Line terms need `lines` (the scene's line query); their pdf is 0 at hidden points.
   std::vector<double> weights(const ShadingPoint& sp, int light_index, const Vec3& light_point,
-                              int sample_multiplier = 1) const;
+                              int sample_multiplier = 1, const LineQuery* lines = nullptr) const;
+
+  // Does the method have line terms (so the Visibility must provide a line query)?
+  bool needs_line_query() const;
 
   const MethodSpec& method() const { return method_; }
 

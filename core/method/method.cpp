@@ -76,8 +76,7 @@ class MethodParser {
              alternatives(kCombines));
       method.combine = entry->second;
     }
-    if (pos_ != text_.size())
-      fail("unexpected character '" + std::string(1, text_[pos_]) + "'");
+    if (pos_ != text_.size()) fail("unexpected character '" + std::string(1, text_[pos_]) + "'");
     if (method.total_samples() > kMaxMethodSamples)
       fail("asks for " + std::to_string(method.total_samples()) +
            " samples per shading point; at most " + std::to_string(kMaxMethodSamples));
@@ -94,8 +93,8 @@ class MethodParser {
 
   std::string_view read_word() {
     size_t start = pos_;
-    while (pos_ < text_.size() && (std::isalnum(static_cast<unsigned char>(text_[pos_])) ||
-                                   text_[pos_] == '-'))
+    while (pos_ < text_.size() &&
+           (std::isalnum(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '-'))
       ++pos_;
     return text_.substr(start, pos_ - start);
   }
@@ -173,7 +172,9 @@ std::string_view direction_name(LineDirection direction) {
   return "?";
 }
 
-MethodSpec parse_method(std::string_view text) { return MethodParser(text).parse(); }
+MethodSpec parse_method(std::string_view text) {
+  return MethodParser(text).parse();
+}
 
 std::string to_string(const MethodSpec& method) {
   std::string out;

@@ -13,7 +13,16 @@
 
 namespace penumbra {
 
-enum class StrategyKind { Bsdf, Area, SolidAngle, ProjectedSolidAngle, Ltc, LineArea, LineSolidAngle, LineBd16 };
+enum class StrategyKind {
+  Bsdf,
+  Area,
+  SolidAngle,
+  ProjectedSolidAngle,
+  Ltc,
+  LineArea,
+  LineSolidAngle,
+  LineBd16
+};
 enum class LineDirection { U, V, Rand };
 enum class Combine { Balance, Power, Avg, Smooth, SmoothFixed, Weighted, ClampedOptimal };
 
@@ -31,7 +40,7 @@ struct MethodSpec {
   bool operator==(const MethodSpec&) const = default;
 };
 
-inline constexpr int kMaxTermCount = 4096;     // COUNT of one term
+inline constexpr int kMaxTermCount = 4096;      // COUNT of one term
 inline constexpr int kMaxMethodSamples = 4096;  // sum of COUNT over the terms
 inline constexpr int kMaxMethodTerms = 16;
 

@@ -5,7 +5,9 @@
 namespace penumbra {
 
 SceneShading::SceneShading(std::shared_ptr<const Scene> scene, const MethodSpec& method)
-    : scene_(std::move(scene)), embree_(*scene_), direct_(*scene_, method) {}
+    : scene_(std::move(scene)), embree_(*scene_), direct_(*scene_, method) {
+  if (direct_.needs_line_query()) line_query_ = std::make_unique<LineQuery>(*scene_);
+}
 
 SceneShading::FirstHit SceneShading::first_hit(const Vec3& origin, const Vec3& direction) const {
   FirstHit result;
@@ -32,8 +34,8 @@ SceneShading::FirstHit SceneShading::first_hit(const Vec3& origin, const Vec3& d
   ShadingPoint sp;
   sp.position = hit->position;
   sp.wo = -direction;
-  sp.normal = dot(hit->geometric_normal, sp.wo) < 0 ? -hit->geometric_normal
-                                                    : hit->geometric_normal;
+  sp.normal =
+      dot(hit->geometric_normal, sp.wo) < 0 ? -hit->geometric_normal : hit->geometric_normal;
   sp.material = &scene_->materials[scene_->triangle_materials[hit->triangle]];
   result.shading_point = sp;
   return result;

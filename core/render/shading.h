@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 
+#include "core/lines/line_query.h"
 #include "core/method/direct_lighting.h"
 #include "core/render/embree_scene.h"
 #include "core/scene/scene.h"
@@ -22,6 +23,8 @@ class SceneShading : public Visibility {
   bool occluded(const Vec3& from, const Vec3& normal, const Vec3& to) const override {
     return embree_.occluded(from, normal, to);
   }
+  // Built only when the method has line terms (the shadow-triangle query over the occluders).
+  const LineQuery* line_query() const override { return line_query_.get(); }
 
   // What the camera ray sees first. Lights seen directly (front side) give `emitted`; an occluder
   // gives a shading point; nothing gives neither.
@@ -38,6 +41,7 @@ class SceneShading : public Visibility {
   std::shared_ptr<const Scene> scene_;
   EmbreeScene embree_;
   DirectLighting direct_;
+  std::unique_ptr<LineQuery> line_query_;
 };
 
 }  // namespace penumbra

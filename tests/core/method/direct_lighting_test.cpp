@@ -23,8 +23,8 @@ Light polygon_light(std::vector<Vec3> vertices, Rgb radiance) {
   light.type = LightType::Polygon;
   light.vertices = std::move(vertices);
   light.radiance = radiance;
-  light.normal = normalize(cross(light.vertices[1] - light.vertices[0],
-                                 light.vertices[2] - light.vertices[0]));
+  light.normal = normalize(
+      cross(light.vertices[1] - light.vertices[0], light.vertices[2] - light.vertices[0]));
   // Area and centroid of a planar polygon (fan from vertex 0).
   double area = 0;
   Vec3 centroid;
@@ -40,8 +40,8 @@ Light polygon_light(std::vector<Vec3> vertices, Rgb radiance) {
 }
 
 Light quad_light(Vec3 origin, Vec3 edge1, Vec3 edge2, Rgb radiance) {
-  Light light = polygon_light({origin, origin + edge1, origin + edge1 + edge2, origin + edge2},
-                              radiance);
+  Light light =
+      polygon_light({origin, origin + edge1, origin + edge1 + edge2, origin + edge2}, radiance);
   light.type = LightType::Quad;
   light.origin = origin;
   light.edge1 = edge1;
@@ -67,8 +67,11 @@ std::vector<Light> test_lights() {
       quad_light({-0.3, 1, -0.2}, {0.8, 0, 0}, {0, 0, 0.5}, {4, 4, 4}),
       // A triangle and a pentagon, tilted, facing down-ish.
       polygon_light({{-0.5, 0.8, -0.4}, {0.6, 1.1, -0.3}, {0.1, 0.9, 0.6}}, {3, 3, 3}),
-      polygon_light({{0.0, 1.0, -0.5}, {0.47, 1.0, -0.15}, {0.29, 1.0, 0.4},
-                     {-0.29, 1.0, 0.4}, {-0.47, 1.0, -0.15}},
+      polygon_light({{0.0, 1.0, -0.5},
+                     {0.47, 1.0, -0.15},
+                     {0.29, 1.0, 0.4},
+                     {-0.29, 1.0, 0.4},
+                     {-0.47, 1.0, -0.15}},
                     {2, 2, 2}),
   };
 }
@@ -120,24 +123,22 @@ TEST_P(Unbiased, ConvergesToLambertsClosedForm) {
     double expected = closed_form(scene, sp).y;
     // Within 4 standard errors (plus a hair for the zero-variance cases).
     EXPECT_NEAR(mean, expected, 4 * standard_error + 1e-9 * expected)
-        << c.method << " on a " << light.vertices.size() << "-gon: mean " << mean
-        << " closed form " << expected << " standard error " << standard_error;
+        << c.method << " on a " << light.vertices.size() << "-gon: mean " << mean << " closed form "
+        << expected << " standard error " << standard_error;
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(
     EveryPointStrategyAndCombination, Unbiased,
-    ::testing::Values(UnbiasedCase{"area", Pattern::Random}, UnbiasedCase{"sa", Pattern::Random},
-                      UnbiasedCase{"bsdf", Pattern::Random},
-                      UnbiasedCase{"bsdf+sa", Pattern::Random},
-                      UnbiasedCase{"bsdf+sa/power", Pattern::Random},
-                      UnbiasedCase{"bsdf+sa/avg", Pattern::Random},
-                      UnbiasedCase{"area+2*sa/balance", Pattern::Random},
-                      UnbiasedCase{"area+bsdf+sa/power", Pattern::Random},
-                      UnbiasedCase{"4*sa", Pattern::Stratified},
-                      UnbiasedCase{"4*area+4*bsdf", Pattern::Cmj},
-                      UnbiasedCase{"psa", Pattern::Random},
-                      UnbiasedCase{"bsdf+psa/power", Pattern::Random}),
+    ::testing::Values(
+        UnbiasedCase{"area", Pattern::Random}, UnbiasedCase{"sa", Pattern::Random},
+        UnbiasedCase{"bsdf", Pattern::Random}, UnbiasedCase{"bsdf+sa", Pattern::Random},
+        UnbiasedCase{"bsdf+sa/power", Pattern::Random},
+        UnbiasedCase{"bsdf+sa/avg", Pattern::Random},
+        UnbiasedCase{"area+2*sa/balance", Pattern::Random},
+        UnbiasedCase{"area+bsdf+sa/power", Pattern::Random},
+        UnbiasedCase{"4*sa", Pattern::Stratified}, UnbiasedCase{"4*area+4*bsdf", Pattern::Cmj},
+        UnbiasedCase{"psa", Pattern::Random}, UnbiasedCase{"bsdf+psa/power", Pattern::Random}),
     [](const auto& info) {
       std::string name = info.param.method;
       for (char& ch : name)
@@ -205,15 +206,20 @@ TEST(DirectLighting, FiniteInDegenerateConfigurations) {
       {"inside the light's plane, within the light",
        quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
        {{0, 1, 0}, {0, -1, 0}, {0, -1, 0}, white}},
-      {"behind the light", quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
+      {"behind the light",
+       quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
        {{0, 2, 0}, {0, -1, 0}, {0, -1, 0}, white}},
-      {"1e-4 below the light", quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
+      {"1e-4 below the light",
+       quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
        {{0.1, 1 - 1e-4, 0.1}, {0, 1, 0}, {0, 1, 0}, white}},
-      {"1 cm light at 40 m", quad_light({-0.005, 40, -0.005}, {0.01, 0, 0}, {0, 0, 0.01}, {1e4, 1e4, 1e4}),
+      {"1 cm light at 40 m",
+       quad_light({-0.005, 40, -0.005}, {0.01, 0, 0}, {0, 0, 0.01}, {1e4, 1e4, 1e4}),
        {{0, 0, 0}, {0, 1, 0}, {0, 1, 0}, white}},
-      {"1 mm light at 40 m", quad_light({-0.0005, 40, -0.0005}, {0.001, 0, 0}, {0, 0, 0.001}, {1e6, 1e6, 1e6}),
+      {"1 mm light at 40 m",
+       quad_light({-0.0005, 40, -0.0005}, {0.001, 0, 0}, {0, 0, 0.001}, {1e6, 1e6, 1e6}),
        {{0, 0, 0}, {0, 1, 0}, {0, 1, 0}, white}},
-      {"grazing normal", quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
+      {"grazing normal",
+       quad_light({-0.5, 1, -0.5}, {1, 0, 0}, {0, 0, 1}, {1, 1, 1}),
        {{0, 0, 0}, normalize(Vec3{1, 1e-9, 0}), normalize(Vec3{1, 1e-6, 0}), white}},
   };
   for (const Case& c : cases) {
@@ -234,7 +240,7 @@ TEST(DirectLighting, FiniteInDegenerateConfigurations) {
 
 TEST(DirectLighting, RefusesWhatIsNotAvailableWithAClearError) {
   Scene scene = single_light_scene(test_lights()[0]);
-  for (const char* method : {"line-sa:v", "bsdf+line-bd16:rand", "ltc"}) {
+  for (const char* method : {"bsdf+line-bd16:rand", "ltc"}) {
     try {
       DirectLighting direct(scene, parse_method(method));
       ADD_FAILURE() << method << " accepted";

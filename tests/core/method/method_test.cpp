@@ -29,8 +29,8 @@ TEST(MethodGrammar, ParsesEveryFormOfTheContract) {
 }
 
 TEST(MethodGrammar, RoundTripsThroughTheCanonicalText) {
-  for (const char* text : {"sa", "bsdf+sa", "bsdf+3*line-sa:v/smooth", "line-bd16:rand",
-                           "16*area", "line-area:u+line-area:v/avg", "psa+ltc/weighted"}) {
+  for (const char* text : {"sa", "bsdf+sa", "bsdf+3*line-sa:v/smooth", "line-bd16:rand", "16*area",
+                           "line-area:u+line-area:v/avg", "psa+ltc/weighted"}) {
     MethodSpec m = parse_method(text);
     EXPECT_EQ(parse_method(to_string(m)), m) << text << " -> " << to_string(m);
   }
