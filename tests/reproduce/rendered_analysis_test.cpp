@@ -6,6 +6,8 @@
 //    is its bias and is the same with any trial count; results do not depend on the thread count.
 //  - variance_convergence.h: unoccluded pixel, 2D stratified (jittered) area sampling of a smooth
 //    integrand has variance ~ N^-2 and random sampling ~ N^-1 (closed forms of the slopes).
+//  - disk_square_rejection.h: the paper's rejection sampling of a disk is unbiased: its mean
+//    matches the closed form of an unoccluded disk seen on its axis, rho L R^2 / (h^2 + R^2).
 //  - peters_reproduction.h: random configurations are convex, planar, face the shading point,
 //    and the measurements are finite.
 
@@ -15,6 +17,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "core/analysis/disk_square_rejection.h"
 #include "core/analysis/pattern_error.h"
 #include "core/analysis/peters_reproduction.h"
 #include "core/analysis/variance_convergence.h"
@@ -152,6 +155,47 @@ TEST(VarianceConvergence, UnoccludedSlopesMatchTheClosedForms) {
   EXPECT_THROW(
       measure_variance_convergence(scene, lit.pixels, "line-nope", Pattern::Random, counts, 8, 1),
       FormatError);
+}
+
+class NothingOccludes : public Visibility {
+ public:
+  bool occluded(const Vec3&, const Vec3&, const Vec3&) const override { return false; }
+};
+
+TEST(DiskSquareRejection, UnbiasedAgainstTheOnAxisClosedForm) {
+  auto scene = bundled("spheres-plane-disk");
+  const Light& disk = scene->lights.at(0);
+  ASSERT_EQ(disk.type, LightType::Disk);
+  ShadingPoint sp;
+  sp.position = {disk.center.x, 0.0, disk.center.z};
+  sp.normal = {0, 1, 0};
+  sp.wo = normalize(Vec3{0, 1, 1});
+  sp.material = &scene->materials.at(0);
+  const double h = disk.center.y, r = disk.radius;
+  // Lambertian (rho / pi) times the irradiance of a uniform disk on its axis, pi L R^2/(h^2+R^2).
+  const double expected = sp.material->albedo.x * disk.radiance.x * r * r / (h * h + r * r);
+  NothingOccludes nothing;
+  for (Pattern pattern : {Pattern::Random, Pattern::Stratified, Pattern::UniformJitter}) {
+    const int trials = 4000;
+    double sum = 0, sum_squares = 0;
+    for (int t = 0; t < trials; ++t) {
+      StreamKey key{17, 3, uint32_t(t), 0};
+      double e = estimate_disk_lights_by_square_rejection(*scene, sp, nothing, pattern, key, 16).x;
+      ASSERT_TRUE(std::isfinite(e));
+      sum += e;
+      sum_squares += e * e;
+    }
+    double mean = sum / trials;
+    double standard_error = std::sqrt((sum_squares / trials - mean * mean) / (trials - 1));
+    EXPECT_NEAR(mean, expected, 4 * standard_error + 1e-12 * expected)
+        << pattern_name(pattern) << ": standard error " << standard_error;
+  }
+  // Behind the light: nothing.
+  sp.position = {0, 4, 0};
+  EXPECT_EQ(estimate_disk_lights_by_square_rejection(*scene, sp, nothing, Pattern::Random,
+                                                     StreamKey{}, 16)
+                .x,
+            0.0);
 }
 
 TEST(PetersConfigurations, ConvexPlanarAndFacingTheShadingPoint) {
