@@ -105,8 +105,7 @@ void radius_squared_and_complement(const EdgeEllipse& e, const Vec2& w, double* 
 // edge vectors to stay accurate for tiny, distant polygons.
 double plane_offset(std::span<const Vec3> v) {
   Vec3 area_vector;
-  for (size_t i = 1; i + 1 < v.size(); ++i)
-    area_vector += cross_accurate(v[i] - v[0], v[i + 1] - v[0]);
+  for (size_t i = 1; i + 1 < v.size(); ++i) area_vector += cross(v[i] - v[0], v[i + 1] - v[0]);
   return dot(area_vector, v[0]);
 }
 
@@ -215,12 +214,11 @@ ProjectedSolidAngleSampler::ProjectedSolidAngleSampler(std::span<const Vec3> ver
   for (int i = 0; i < m; ++i) {
     if (count > 0) {
       const Vec3& previous = v[count - 1];
-      if (cross_accurate(previous, clipped[i]) == Vec3{} && dot(previous, clipped[i]) > 0) continue;
+      if (cross(previous, clipped[i]) == Vec3{} && dot(previous, clipped[i]) > 0) continue;
     }
     v[count++] = clipped[i];
   }
-  while (count > 1 && cross_accurate(v[count - 1], v[0]) == Vec3{} && dot(v[count - 1], v[0]) > 0)
-    --count;
+  while (count > 1 && cross(v[count - 1], v[0]) == Vec3{} && dot(v[count - 1], v[0]) > 0) --count;
   if (count < 3) return;
   m = count;
 
