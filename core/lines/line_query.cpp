@@ -130,9 +130,12 @@ struct LinearRange4 {
     middle = _mm_add_ps(
         _mm_add_ps(offset, _mm_mul_ps(gradient[0], center[0])),
         _mm_add_ps(_mm_mul_ps(gradient[1], center[1]), _mm_mul_ps(gradient[2], center[2])));
-    radius = _mm_add_ps(_mm_add_ps(error, _mm_mul_ps(gradient_magnitude[0], extent[0])),
-                        _mm_add_ps(_mm_mul_ps(gradient_magnitude[1], extent[1]),
-                                   _mm_mul_ps(gradient_magnitude[2], extent[2])));
+    radius = radius_of(extent);
+  }
+  __m128 radius_of(const __m128 extent[3]) const {
+    return _mm_add_ps(_mm_add_ps(error, _mm_mul_ps(gradient_magnitude[0], extent[0])),
+                      _mm_add_ps(_mm_mul_ps(gradient_magnitude[1], extent[1]),
+                                 _mm_mul_ps(gradient_magnitude[2], extent[2])));
   }
 };
 
@@ -349,7 +352,11 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
   const LinearRange4 distance_range(normalize(shadow->plane_normal), x, scene_max_abs_);
   const LinearRange4 alpha_range(shadow->alpha_gradient, x, scene_max_abs_);
   const LinearRange4 beta_range(shadow->beta_gradient, x, scene_max_abs_);
-  const LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);
+  // Depth s = alpha + beta: its middle is the sum of theirs, so its error bound is the sum of
+  // theirs too (plus its own, for the radius).
+  LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);
+  depth_range.error =
+      _mm_add_ps(depth_range.error, _mm_add_ps(alpha_range.error, beta_range.error));
   const __m128 zero = _mm_setzero_ps();
   const __m128 tiny = _mm_set1_ps(FLT_MIN);
   const __m128 sign_bit = _mm_set1_ps(-0.0f);
@@ -416,7 +423,8 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     distance_range.evaluate(center, extent, distance_middle, distance_radius);
     alpha_range.evaluate(center, extent, alpha_middle, alpha_radius);
     beta_range.evaluate(center, extent, beta_middle, beta_radius);
-    depth_range.evaluate(center, extent, depth_middle, depth_radius);
+    depth_middle = _mm_add_ps(alpha_middle, beta_middle);
+    depth_radius = depth_range.radius_of(extent);
     __m128 alpha_lower = _mm_sub_ps(alpha_middle, alpha_radius);
     __m128 alpha_upper = _mm_add_ps(alpha_middle, alpha_radius);
     __m128 beta_lower = _mm_sub_ps(beta_middle, beta_radius);
