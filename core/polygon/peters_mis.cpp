@@ -5,6 +5,8 @@
 namespace penumbra {
 namespace {
 
+// Where no technique has weight in this channel (sum_k c_k p_k = 0: the light is black in it,
+// or only techniques with c_k = 0 reach the point) fall back to balance: weights still sum to 1.
 double channel_weighted_balance(int j, const TechniqueDensities& pdfs,
                                 const std::array<double, kPetersTechniques>& c) {
   double sum = 0;
@@ -13,13 +15,28 @@ double channel_weighted_balance(int j, const TechniqueDensities& pdfs,
   return std::max(0.0, c[j]) * pdfs[j] / sum;
 }
 
+Rgb combine_samples(int j, std::span<const std::optional<TechniqueSample>> samples,
+                    const UnshadowedIntegrals& unshadowed, PetersHeuristic heuristic, double v,
+                    const TechniqueCounts& counts) {
+  Rgb sum{0, 0, 0};
+  for (const std::optional<TechniqueSample>& s : samples) {
+    if (!s) continue;
+    double own_pdf = s->pdfs[j];
+    if (!(own_pdf > 0) || !std::isfinite(own_pdf) || !is_finite(s->integrand)) continue;
+    Rgb term =
+        peters_mis_weight(heuristic, j, s->pdfs, unshadowed, v, counts) * s->integrand / own_pdf;
+    if (is_finite(term)) sum += term;
+  }
+  return samples.empty() ? sum : sum / double(samples.size());
+}
+
 }  // namespace
 
-double balance_weight(int j, const TechniqueDensities& pdfs) {
+double balance_weight(int j, const TechniqueDensities& pdfs, const TechniqueCounts& counts) {
   double sum = 0;
-  for (double p : pdfs) sum += p;
+  for (int k = 0; k < kPetersTechniques; ++k) sum += counts[k] * pdfs[k];
   if (!(sum > 0) || !std::isfinite(sum)) return 0;
-  return pdfs[j] / sum;
+  return counts[j] * pdfs[j] / sum;
 }
 
 Rgb weighted_balance_weight(int j, const TechniqueDensities& pdfs,
@@ -34,39 +51,44 @@ Rgb weighted_balance_weight(int j, const TechniqueDensities& pdfs,
 }
 
 Rgb clamped_optimal_weight(int j, const TechniqueDensities& pdfs,
-                           const UnshadowedIntegrals& unshadowed, double v) {
-  double balance = balance_weight(j, pdfs);
+                           const UnshadowedIntegrals& unshadowed, double v,
+                           const TechniqueCounts& counts) {
+  double balance = balance_weight(j, pdfs, counts);
   return v * weighted_balance_weight(j, pdfs, unshadowed) +
          (1.0 - v) * Rgb{balance, balance, balance};
 }
 
 Rgb peters_mis_weight(PetersHeuristic heuristic, int j, const TechniqueDensities& pdfs,
-                      const UnshadowedIntegrals& unshadowed, double v) {
+                      const UnshadowedIntegrals& unshadowed, double v,
+                      const TechniqueCounts& counts) {
   switch (heuristic) {
     case PetersHeuristic::Balance: {
-      double w = balance_weight(j, pdfs);
+      double w = balance_weight(j, pdfs, counts);
       return {w, w, w};
     }
     case PetersHeuristic::Weighted:
       return weighted_balance_weight(j, pdfs, unshadowed);
     case PetersHeuristic::ClampedOptimal:
-      return clamped_optimal_weight(j, pdfs, unshadowed, v);
+      return clamped_optimal_weight(j, pdfs, unshadowed, v, counts);
   }
   return {0, 0, 0};
 }
 
 Rgb combine_psa_ltc(const std::array<std::optional<TechniqueSample>, kPetersTechniques>& samples,
                     const UnshadowedIntegrals& unshadowed, PetersHeuristic heuristic, double v) {
-  Rgb estimate{0, 0, 0};
-  for (int j = 0; j < kPetersTechniques; ++j) {
-    if (!samples[j]) continue;
-    const TechniqueSample& s = *samples[j];
-    double own_pdf = s.pdfs[j];
-    if (!(own_pdf > 0) || !std::isfinite(own_pdf) || !is_finite(s.integrand)) continue;
-    Rgb term = peters_mis_weight(heuristic, j, s.pdfs, unshadowed, v) * s.integrand / own_pdf;
-    if (is_finite(term)) estimate += term;
-  }
-  return estimate;
+  return combine_psa_ltc({&samples[0], 1}, {&samples[1], 1}, unshadowed, heuristic, v);
+}
+
+Rgb combine_psa_ltc(std::span<const std::optional<TechniqueSample>> psa_samples,
+                    std::span<const std::optional<TechniqueSample>> ltc_samples,
+                    const UnshadowedIntegrals& unshadowed, PetersHeuristic heuristic, double v) {
+  TechniqueCounts counts{int(psa_samples.size()), int(ltc_samples.size())};
+  // A technique without samples estimates nothing: the others take its part (c = 0 for it).
+  UnshadowedIntegrals c = unshadowed;
+  for (int k = 0; k < kPetersTechniques; ++k)
+    if (counts[k] == 0) c[k] = {0, 0, 0};
+  return combine_samples(0, psa_samples, c, heuristic, v, counts) +
+         combine_samples(1, ltc_samples, c, heuristic, v, counts);
 }
 
 }  // namespace penumbra

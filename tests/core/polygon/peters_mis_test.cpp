@@ -77,16 +77,24 @@ struct PsaLtcPair {
   struct Statistics {
     Rgb mean, variance;
   };
+  // Statistics of `count` estimates, each from n_psa psa and n_ltc ltc samples (one of each:
+  // the array form of combine_psa_ltc; otherwise the span form).
   Statistics run(PetersHeuristic heuristic, const LobeTimesCosine& lobe,
-                 const std::function<bool(const Vec3&)>& visible, int count, uint64_t seed) const {
+                 const std::function<bool(const Vec3&)>& visible, int count, uint64_t seed,
+                 int n_psa = 1, int n_ltc = 1) const {
     std::mt19937_64 rng(seed);
     Rgb sum{0, 0, 0}, sum2{0, 0, 0};
     for (int k = 0; k < count; ++k) {
-      Vec2 u0{uniform(rng), uniform(rng)}, u1{uniform(rng), uniform(rng)};
-      std::array<std::optional<TechniqueSample>, 2> samples = {
-          technique_sample(0, psa.sample(u0), lobe, visible),
-          technique_sample(1, ltc.sample(u1), lobe, visible)};
-      Rgb f = combine_psa_ltc(samples, unshadowed, heuristic);
+      std::vector<std::optional<TechniqueSample>> psa_samples, ltc_samples;
+      for (int i = 0; i < n_psa; ++i)
+        psa_samples.push_back(
+            technique_sample(0, psa.sample({uniform(rng), uniform(rng)}), lobe, visible));
+      for (int i = 0; i < n_ltc; ++i)
+        ltc_samples.push_back(
+            technique_sample(1, ltc.sample({uniform(rng), uniform(rng)}), lobe, visible));
+      Rgb f = n_psa == 1 && n_ltc == 1
+                  ? combine_psa_ltc({psa_samples[0], ltc_samples[0]}, unshadowed, heuristic)
+                  : combine_psa_ltc(psa_samples, ltc_samples, unshadowed, heuristic);
       EXPECT_TRUE(is_finite(f));
       sum += f;
       sum2 += f * f;
@@ -123,6 +131,11 @@ TEST(PetersMis, WeightsSumToOne) {
               0.75 * peters_mis_weight(PetersHeuristic::Balance, 1, pdfs, cs);
   Rgb clamped = clamped_optimal_weight(1, pdfs, cs, 0.25);
   for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(clamped[ch], blend[ch], 1e-15);
+  // Counts enter balance as n_k p_k.
+  EXPECT_NEAR(balance_weight(0, pdfs, {3, 1}), 6.0 / 12.0, 1e-15);
+  Rgb clamped_counts = clamped_optimal_weight(0, pdfs, cs, 0.5, {3, 1}) +
+                       clamped_optimal_weight(1, pdfs, cs, 0.5, {3, 1});
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(clamped_counts[ch], 1.0, 1e-15);
 }
 
 // Sec. 4.2: with f_r cos = a_0 cos / pi + a_1 p_M (the BRDF is its LTC fit) and no occlusion,
@@ -170,10 +183,18 @@ TEST(PetersMis, WeightedBalanceHasZeroVarianceWhenTheBrdfIsItsLtc) {
     Rgb expected = setup.unshadowed[0] + setup.unshadowed[1];
     auto weighted = setup.run(PetersHeuristic::Weighted, ltc_brdf, always, 4000, 97);
     auto balance = setup.run(PetersHeuristic::Balance, ltc_brdf, always, 4000, 97);
+    // Unequal counts (3 psa, 1 ltc; and ltc alone): still exact, since the weights ignore counts.
+    auto three_to_one = setup.run(PetersHeuristic::Weighted, ltc_brdf, always, 500, 98, 3, 1);
+    auto ltc_alone = setup.run(PetersHeuristic::Weighted, ltc_brdf, always, 500, 99, 0, 2);
     for (int ch = 0; ch < 3; ++ch) {
       double relative_std = std::sqrt(weighted.variance[ch]) / weighted.mean[ch];
       EXPECT_LT(relative_std, 1e-6) << test_case.name << " channel " << ch;
       EXPECT_NEAR(weighted.mean[ch], expected[ch], 1e-9 * expected[ch]) << test_case.name;
+      EXPECT_LT(std::sqrt(three_to_one.variance[ch]) / three_to_one.mean[ch], 1e-6)
+          << test_case.name;
+      EXPECT_NEAR(three_to_one.mean[ch], expected[ch], 1e-9 * expected[ch]) << test_case.name;
+      // Alone, ltc is an ordinary (unbiased, not exact) estimator of the whole integral.
+      EXPECT_NEAR(ltc_alone.mean[ch], expected[ch], 0.1 * expected[ch]) << test_case.name;
       // The balance heuristic is unbiased but not exact here (the test can fail).
       EXPECT_GT(std::sqrt(balance.variance[ch]) / balance.mean[ch], 1e-3) << test_case.name;
       EXPECT_NEAR(balance.mean[ch], expected[ch], 0.05 * expected[ch]) << test_case.name;
