@@ -2,9 +2,12 @@
 // Helpers for the farm's integration tests: child processes (coordinator, workers) on loopback,
 // a small scene written to a temporary folder, and a local render to compare against.
 
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,6 +36,22 @@ namespace penumbra::farm::testing {
 
 inline std::string binary(const std::string& relative) {
   return std::string(PENUMBRA_BINARY_DIR) + "/" + relative;
+}
+
+// A TCP port on 127.0.0.1 that was free a moment ago (the kernel's choice for port 0).
+inline int free_port() {
+  int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = 0;
+  socklen_t length = sizeof address;
+  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0)
+    throw std::runtime_error("cannot find a free port");
+  int port = ntohs(address.sin_port);
+  ::close(fd);
+  return port;
 }
 
 inline std::filesystem::path fresh_directory(const std::string& name) {
