@@ -195,7 +195,8 @@ double LineIntegrator::diffuse(double t0, double t1) const {
     width = hi - lo;
   }
   // (1/2) [width cos(theta_n) + cos(lo + hi - theta_n) sin(width)]  (Appendix A, re-derived).
-  double integral = 0.5 * (width * std::cos(theta_n_) + std::cos(lo + hi - theta_n_) * std::sin(width));
+  double integral =
+      0.5 * (width * std::cos(theta_n_) + std::cos(lo + hi - theta_n_) * std::sin(width));
   return std::max(0.0, prefactor_ * normal_scale_ * integral);
 }
 

@@ -94,9 +94,9 @@ class LineIntegrator {
 
   const LineReceiver* receiver_;
   bool zero_ = true;
-  double prefactor_ = 0;      // q / h^2
-  double h_ = 0;              // distance of x from the line
-  double s_a_ = 0, s_b_ = 0;  // positions of a and b along e from the foot
+  double prefactor_ = 0;                   // q / h^2
+  double h_ = 0;                           // distance of x from the line
+  double s_a_ = 0, s_b_ = 0;               // positions of a and b along e from the foot
   double normal_scale_ = 0, theta_n_ = 0;  // N, theta_n
   double mirror_scale_ = 0, theta_r_ = 0;  // M, theta_R
 };
