@@ -102,8 +102,8 @@ std::optional<LineOffsetDistribution::Line> LineOffsetDistribution::sample(doubl
   // The piece [k, k+1] with cumulative_[k] <= target < cumulative_[k+1]; zero-area pieces are
   // never chosen (upper_bound skips equal cumulative values).
   size_t pieces = breakpoints_.size() - 1;
-  size_t k = static_cast<size_t>(
-      std::upper_bound(cumulative_.begin(), cumulative_.end(), target) - cumulative_.begin());
+  size_t k = static_cast<size_t>(std::upper_bound(cumulative_.begin(), cumulative_.end(), target) -
+                                 cumulative_.begin());
   k = (k == 0) ? 0 : k - 1;
   if (k >= pieces) {
     // target == total: the last piece with area.
@@ -180,8 +180,7 @@ Bd16LineSampler::Bd16LineSampler(const Light& light, const Material& material, c
 const LineOffsetDistribution& Bd16LineSampler::distribution_for(const Vec2& direction_u) const {
   if (mode_ != Bd16Direction::Random) return fixed_;
   if (direction_u.x != random_key_) {
-    random_ =
-        LineOffsetDistribution(*light_, bd16_line_direction(*light_, mode_, direction_u));
+    random_ = LineOffsetDistribution(*light_, bd16_line_direction(*light_, mode_, direction_u));
     random_key_ = direction_u.x;
   }
   return random_;
@@ -190,8 +189,7 @@ const LineOffsetDistribution& Bd16LineSampler::distribution_for(const Vec2& dire
 Rgb Bd16LineSampler::estimate_with(double offset_u, const Vec2& direction_u,
                                    const LineQuery* query) const {
   if (!facing_) return {0, 0, 0};
-  std::optional<LineOffsetDistribution::Line> line =
-      distribution_for(direction_u).sample(offset_u);
+  std::optional<LineOffsetDistribution::Line> line = distribution_for(direction_u).sample(offset_u);
   if (!line || !(line->pdf > 0)) return {0, 0, 0};
   LineIntegrator integrator(receiver_, line->a, line->b, light_->normal);
   if (integrator.zero()) return {0, 0, 0};

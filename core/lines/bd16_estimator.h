@@ -16,7 +16,8 @@
 // a rotated parallelogram. Sampling picks a piece by its area (the CDF at the breakpoints) and
 // inverts the quadratic CDF inside it: with l rising linearly from l0 to l1 over the piece and
 // xi in [0,1) the fraction of the piece's area, the fraction s of its width solves
-//   l0 s + (l1 - l0) s^2 / 2 = xi (l0 + l1) / 2,  s = xi (l0 + l1) / (l0 + sqrt(l0^2 + xi (l1^2 - l0^2)))
+//   l0 s + (l1 - l0) s^2 / 2 = xi (l0 + l1) / 2,  s = xi (l0 + l1) / (l0 + sqrt(l0^2 + xi (l1^2 -
+//   l0^2)))
 // (the cancellation-free root; s = sqrt(xi) when l0 = 0). The thresholds between pieces are
 // the exact cumulative areas of the same trapezoids the density is evaluated from, so the
 // sampled histogram and pdf_of_offset agree at the breakpoints (tests: chi-square with many
