@@ -101,12 +101,12 @@ PreparedStrategy prepare(const MethodTerm& term, const ShadingPoint& sp, const L
 }
 
 // Aspect of the 2D strata: strategies that map u.x along edge1 and u.y along edge2 of a quad.
-// Line terms put the line's offset in u.x: one stratum per line across x (1D stratified
-// offsets, Billen & Dutre Sec. 6), the point along the line in u.y.
-double strata_aspect(StrategyKind kind, const Light& light) {
-  if (is_line_strategy(kind)) return 1e18;
+// Line terms (u.x the line's offset, u.y the point along it) and the BSDF use square strata:
+// their sample space is not the light's rectangle, and a square grid has no leftover samples
+// at N = 4^k (cmj still stratifies every 1D projection, the line offsets included, in N strata).
+double strata_aspect(const MethodTerm& term, const Light& light) {
   if (light.type != LightType::Quad) return 1.0;
-  if (kind != StrategyKind::Area && kind != StrategyKind::SolidAngle) return 1.0;
+  if (term.strategy != StrategyKind::Area && term.strategy != StrategyKind::SolidAngle) return 1.0;
   double e1 = length(light.edge1), e2 = length(light.edge2);
   return (e1 > 0 && e2 > 0) ? e1 / e2 : 1.0;
 }
@@ -465,7 +465,7 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
       samples.resize(n);
       StreamKey stream = key;
       stream.stream = light_term_stream(int(l), int(i));
-      generate_2d(pattern, stream, strata_aspect(term.strategy, light), samples);
+      generate_2d(pattern, stream, strata_aspect(term, light), samples);
 
       for (int j = 0; j < n; ++j) {
         point_lines.reset();
