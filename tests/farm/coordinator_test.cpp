@@ -1,5 +1,7 @@
 // The coordinator's core without gRPC or a renderer: fake workers lease tasks and complete them
 // with synthetic tiles whose values depend on pixel and pass, so the assembled image is known.
+// Built only with the farm (PENUMBRA_FARM=ON); otherwise the program reports a skipped test.
+#if __has_include("penumbra/v1/farm.pb.h")
 #include "server/coordinator.h"
 
 #include <gtest/gtest.h>
@@ -242,6 +244,19 @@ TEST_F(CoordinatorTest, SecondsBudgetOpensBlocksUntilTheBudgetIsSpent) {
                                  expected_film(40, 24, status.passes_complete()).color));
 }
 
+TEST_F(CoordinatorTest, AFullQueueRefusesNewJobsWithResourceExhausted) {
+  options_.max_queued_tasks = 20;
+  auto coordinator = make();
+  coordinator->submit(spec(12));  // 18 tasks
+  try {
+    coordinator->submit(spec(4));  // 6 more
+    ADD_FAILURE() << "the queue limit was not enforced";
+  } catch (const FarmError& error) {
+    EXPECT_EQ(error.code(), FarmErrorCode::ResourceExhausted);
+  }
+  EXPECT_EQ(coordinator->list().size(), 1u);
+}
+
 TEST_F(CoordinatorTest, MalformedResultsAreRefused) {
   auto coordinator = make();
   std::string worker = register_worker(*coordinator, "w");
@@ -265,3 +280,9 @@ TEST_F(CoordinatorTest, MalformedResultsAreRefused) {
 
 }  // namespace
 }  // namespace penumbra::farm
+#else
+#include <gtest/gtest.h>
+TEST(FarmNotBuilt, Skipped) {
+  GTEST_SKIP() << "configured with PENUMBRA_FARM=OFF";
+}
+#endif
