@@ -49,10 +49,21 @@ double beta_continued_fraction(double a, double b, double x) {
   return result;
 }
 
-// integral_0^{pi/2} cos^k = (1/2) B((k+1)/2, 1/2).
+// integral_0^{pi/2} cos^k = (1/2) B((k+1)/2, 1/2). A shading point asks for the same two
+// exponents (m and m+2) many times: the last few are cached per thread (lgamma is slow).
 double half_cosine_power_integral(double k) {
+  struct Entry {
+    double k = -1, value = 0;
+  };
+  thread_local Entry cache[2];
+  for (const Entry& entry : cache) {
+    if (entry.k == k) return entry.value;
+  }
   double a = 0.5 * (k + 1.0);
-  return 0.5 * std::exp(std::lgamma(a) + std::lgamma(0.5) - std::lgamma(a + 0.5));
+  double value = 0.5 * std::exp(std::lgamma(a) + std::lgamma(0.5) - std::lgamma(a + 0.5));
+  cache[1] = cache[0];
+  cache[0] = {k, value};
+  return value;
 }
 
 // Both halves of [0, pi/2] split at w: head = integral_0^w cos^k, tail = integral_w^{pi/2}
