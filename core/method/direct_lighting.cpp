@@ -7,6 +7,7 @@
 #include <variant>
 
 #include "core/lights/light_geometry.h"
+#include "core/lines/bd16_estimator.h"
 #include "core/lines/line_sampling_area.h"
 #include "core/lines/line_sampling_solid_angle.h"
 #include "core/materials/bsdf.h"
@@ -330,6 +331,28 @@ LightLines prepare_light_lines(const MethodSpec& method, const ShadingPoint& sp,
   return lines;
 }
 
+// Billen & Dutré's line-bd16 term: n analytic line estimates with 1D-stratified offsets and
+// one direction per shading point (used by :rand), times the combination weight (1 or 1/T).
+Rgb bd16_estimate(const ShadingPoint& sp, const Light& light, const MethodTerm& term,
+                  const LineQuery& query, Pattern pattern, const StreamKey& stream, int n,
+                  double weight) {
+  thread_local std::vector<double> offsets;
+  offsets.resize(n);
+  generate_1d(pattern, stream, offsets);
+  // The direction's two numbers come from a counter no pattern sample uses.
+  constexpr uint32_t kDirectionSample = 0xffffffffu;
+  Vec2 direction_u{random_uniform(stream, kDirectionSample, 0),
+                   random_uniform(stream, kDirectionSample, 1)};
+  Bd16Direction mode = term.direction == LineDirection::U   ? Bd16Direction::U
+                       : term.direction == LineDirection::V ? Bd16Direction::V
+                                                            : Bd16Direction::Random;
+  Bd16LineSampler sampler(light, *sp.material, sp.position, sp.normal, sp.wo, mode);
+  Rgb sum;
+  for (double offset : offsets) sum += sampler.estimate(offset, direction_u, query);
+  Rgb contribution = sum * (weight / double(n));
+  return is_finite(contribution) ? contribution : Rgb{};
+}
+
 }  // namespace
 
 DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
@@ -378,8 +401,18 @@ DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
         }
         break;
       case StrategyKind::LineBd16:
-        refuse(method, "strategy \"" + name +
-                           "\" is not available yet (Billen & Dutré's analytic lines, issue #3)");
+        // Billen & Dutré's analytic lines: an estimate per line, no point pdf (no MIS).
+        if (method.terms.size() > 1 && method.combine != Combine::Avg)
+          refuse(method,
+                 "strategy \"line-bd16\" integrates each line analytically and has no "
+                 "pdf at a point, so it cannot be combined by \"" +
+                     std::string(combine_name(method.combine)) + "\": use it alone or with /avg");
+        for (size_t l = 0; l < scene.lights.size(); ++l)
+          for (const Material& material : scene.materials)
+            if (auto why = Bd16LineSampler::unsupported(scene.lights[l], material))
+              refuse(method, "strategy \"line-bd16\" cannot shade light " + std::to_string(l) +
+                                 " on material \"" + material.name + "\": " + *why);
+        break;
     }
   }
   switch (method.combine) {
@@ -462,9 +495,14 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
       const bool line_term = is_line_strategy(term.strategy);
       const LineAxis axis = line_axis(term.direction);
       const int n = term.count * multiplier;
-      samples.resize(n);
       StreamKey stream = key;
       stream.stream = light_term_stream(int(l), int(i));
+      if (term.strategy == StrategyKind::LineBd16) {
+        light_sum += bd16_estimate(sp, light, term, *query, pattern, stream, n,
+                                   term_count > 1 ? 1.0 / double(term_count) : 1.0);
+        continue;
+      }
+      samples.resize(n);
       generate_2d(pattern, stream, strata_aspect(term, light), samples);
 
       for (int j = 0; j < n; ++j) {

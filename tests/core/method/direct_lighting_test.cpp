@@ -240,7 +240,7 @@ TEST(DirectLighting, FiniteInDegenerateConfigurations) {
 
 TEST(DirectLighting, RefusesWhatIsNotAvailableWithAClearError) {
   Scene scene = single_light_scene(test_lights()[0]);
-  for (const char* method : {"bsdf+line-bd16:rand", "ltc"}) {
+  for (const char* method : {"ltc"}) {
     try {
       DirectLighting direct(scene, parse_method(method));
       ADD_FAILURE() << method << " accepted";

@@ -291,6 +291,69 @@ TEST(LineMethods, RefusesWhatIsNotDefinedWithAClearError) {
   EXPECT_NE(message(polygon, "bsdf+sa/smooth").find("is a polygon"), std::string::npos);
 }
 
+// Billen & Dutré's analytic lines through the estimator: alone (u, v, rand) and averaged with a
+// point or line term; lambert and phong receivers only.
+Scene bd16_scene(bool occluders) {
+  Scene scene = test_scene(occluders);
+  scene.materials.pop_back();  // the GGX material: line-bd16 refuses it
+  Material phong;
+  phong.name = "phong";
+  phong.type = MaterialType::Phong;
+  phong.kd = {0.3, 0.3, 0.3};
+  phong.ks = {0.4, 0.4, 0.4};
+  phong.exponent = 30;
+  scene.materials.push_back(phong);
+  return scene;
+}
+
+TEST(LineMethods, Bd16UnbiasedUnoccludedAndOccluded) {
+  const char* const methods[] = {"line-bd16:u", "line-bd16:v", "4*line-bd16:rand",
+                                 "line-bd16:u+line-sa:v/avg", "bsdf+2*line-bd16:rand/avg"};
+  Scene open = bd16_scene(false);
+  const Light& light = open.lights[0];
+  ShadingPoint sp = straight_receiver(open);
+  double expected = lambert_polygon_radiance(sp.material->albedo, light.radiance, sp.position,
+                                             sp.normal, light.vertices, light.normal)
+                        .y;
+  for (const char* method : methods) {
+    Estimate e = run(open, method, sp, Pattern::Random, 4000);
+    EXPECT_NEAR(e.mean, expected, 4 * e.standard_error + 1e-9 * expected) << method;
+  }
+  Scene occluded = bd16_scene(true);
+  for (int material : {0, 1}) {
+    ShadingPoint p = straight_receiver(occluded, material);
+    Estimate reference = run(occluded, "bsdf+16*sa", p, Pattern::Stratified, 20000);
+    for (const char* method : methods) {
+      for (Pattern pattern : {Pattern::Random, Pattern::Stratified}) {
+        Estimate e = run(occluded, method, p, pattern, 4000);
+        EXPECT_NEAR(e.mean, reference.mean,
+                    4 * std::hypot(e.standard_error, reference.standard_error))
+            << method << " on material " << material << ", " << pattern_name(pattern);
+      }
+    }
+  }
+}
+
+TEST(LineMethods, Bd16RefusesMisAndUnsupportedMaterials) {
+  auto message = [](const Scene& scene, const char* method) -> std::string {
+    try {
+      DirectLighting direct(scene, parse_method(method));
+    } catch (const FormatError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  Scene scene = bd16_scene(false);
+  EXPECT_EQ(message(scene, "line-bd16:rand"), "");
+  EXPECT_NE(message(scene, "bsdf+line-bd16:u").find("no pdf at a point"), std::string::npos);
+  EXPECT_NE(message(scene, "line-sa:u+line-bd16:u/smooth").find("use it alone or with /avg"),
+            std::string::npos);
+  Scene glossy = test_scene(false);
+  std::string why = message(glossy, "line-bd16:u");
+  EXPECT_NE(why.find("line-bd16"), std::string::npos) << why;
+  EXPECT_NE(why.find("glossy"), std::string::npos) << why;
+}
+
 TEST(LineMethods, NeedsALineQuery) {
   Scene scene = test_scene(false);
   DirectLighting direct(scene, parse_method("line-sa:u"));
