@@ -369,13 +369,15 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
   // Two-quad initialization (Sec. 3.4): the points where the rays through s0, s_h and s1 meet
   // the inner and outer ellipses span two quads; the quad that holds the area is sampled
   // uniformly (area rescaled from the sector to the quads).
-  auto on_ellipse = [](const EdgeEllipse& e, const Vec2& direction) {
-    return scale2(direction, std::sqrt(ellipse_radius_squared(e, direction)));
+  auto radius = [](const EdgeEllipse& e, const Vec2& direction) {
+    return std::sqrt(ellipse_radius_squared(e, direction));
   };
-  Vec2 inner0 = on_ellipse(inner, s0), inner_half = on_ellipse(inner, half),
-       inner1 = on_ellipse(inner, s1);
-  Vec2 outer0 = on_ellipse(outer, s0), outer_half = on_ellipse(outer, half),
-       outer1 = on_ellipse(outer, s1);
+  double inner_r0 = radius(inner, s0), inner_rh = radius(inner, half), inner_r1 = radius(inner, s1);
+  double outer_r0 = radius(outer, s0), outer_rh = radius(outer, half), outer_r1 = radius(outer, s1);
+  Vec2 inner0 = scale2(s0, inner_r0), inner_half = scale2(half, inner_rh),
+       inner1 = scale2(s1, inner_r1);
+  Vec2 outer0 = scale2(s0, outer_r0), outer_half = scale2(half, outer_rh),
+       outer1 = scale2(s1, outer_r1);
   double quad0 = 0.5 * (cross2_plain(outer0, outer_half) - cross2_plain(inner0, inner_half));
   double quad1 = 0.5 * (cross2_plain(outer_half, outer1) - cross2_plain(inner_half, inner1));
   double quads = quad0 + quad1;
@@ -397,8 +399,8 @@ Vec2 ProjectedSolidAngleSampler::two_ellipse_direction(const Sector& s, double a
   Vec2 normal = rotate90(boundary);
   double ia = dot2(r_inner, boundary), ie = dot2(r_inner, normal);
   double oa = dot2(r_outer, boundary), oe = dot2(r_outer, normal);
-  double outer_length = std::sqrt(dot2(outer_k, outer_k));
-  double inner_length = std::sqrt(dot2(inner_k, inner_k));
+  double outer_length = second ? outer_r1 : outer_r0;
+  double inner_length = second ? inner_r1 : inner_r0;
   double b0 = -2.0 * quad_area * ia * oa;
   double b1 = d_outer * outer_length * ia - d_inner * inner_length * oa -
               2.0 * quad_area * (ia * oe + ie * oa);
@@ -504,10 +506,10 @@ std::optional<Vec3> ProjectedSolidAngleSampler::sample(const Vec2& u) const {
   double z2 = (1.0 - u.y) * inner_z2 + u.y * outer_z2;
   Vec2 w_unit = normalize2(w);
   double rho = std::sqrt(std::max(0.0, rho2));
+  // rho^2 + z^2 = 1 up to rounding (r^2 and 1 - r^2 share their denominator): no normalization.
   Vec3 direction{rho * w_unit.x, rho * w_unit.y, std::sqrt(std::max(0.0, z2))};
-  double l = length(direction);
-  if (!(l > 0) || !std::isfinite(l)) return std::nullopt;
-  return direction / l;
+  if (!is_finite(direction)) return std::nullopt;
+  return direction;
 }
 
 std::optional<Vec2> ProjectedSolidAngleSampler::invert(const Vec3& direction) const {
