@@ -55,7 +55,7 @@
 namespace penumbra {
 
 // Integer Phong exponents up to this use the recursion of Eq. 16 on intervals around the lobe.
-inline constexpr int kPhongRecursionMaxExponent = 64;
+inline constexpr int kPhongRecursionMaxExponent = 256;
 
 // The receiver side of the line integrals: what the shading point and its material contribute.
 struct LineReceiver {
