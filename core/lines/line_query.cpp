@@ -418,9 +418,23 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
                               _mm_load_ps(node.center[2])};
     const __m128 extent[3] = {_mm_load_ps(node.extent[0]), _mm_load_ps(node.extent[1]),
                               _mm_load_ps(node.extent[2])};
-    __m128 distance_middle, distance_radius, alpha_middle, alpha_radius, beta_middle, beta_radius,
-        depth_middle, depth_radius;
+    // Cheapest tests first: the box against the crossing region's bounding box and against
+    // the shadow plane (|distance| <= radius). Most rejected nodes fail one of these, and then
+    // the alpha/beta/depth ranges are never computed. Ordered comparisons: NaN centres (empty
+    // slots) fail.
+    __m128 keep = _mm_setzero_ps();
+    keep = _mm_cmpeq_ps(keep, keep);  // all ones
+    for (int k = 0; k < 3; ++k) {
+      keep = _mm_and_ps(keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), region_upper[k]));
+      keep = _mm_and_ps(keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), region_lower[k]));
+    }
+    __m128 distance_middle, distance_radius;
     distance_range.evaluate(center, extent, distance_middle, distance_radius);
+    keep =
+        _mm_and_ps(keep, _mm_cmple_ps(_mm_andnot_ps(sign_bit, distance_middle), distance_radius));
+    if (_mm_movemask_ps(keep) == 0) continue;
+
+    __m128 alpha_middle, alpha_radius, beta_middle, beta_radius, depth_middle, depth_radius;
     alpha_range.evaluate(center, extent, alpha_middle, alpha_radius);
     beta_range.evaluate(center, extent, beta_middle, beta_radius);
     depth_middle = _mm_add_ps(alpha_middle, beta_middle);
@@ -431,18 +445,12 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     __m128 beta_upper = _mm_add_ps(beta_middle, beta_radius);
     __m128 depth_lower = _mm_sub_ps(depth_middle, depth_radius);
     __m128 depth_upper = _mm_add_ps(depth_middle, depth_radius);
-    // Box against the shadow plane (|distance| <= radius), the side planes through x
-    // (alpha >= 0, beta >= 0), the plane through the segment (s <= s_max) and the
-    // self-occlusion plane (s >= s_min). Ordered comparisons: NaN centres (empty slots) fail.
-    __m128 keep = _mm_cmple_ps(_mm_andnot_ps(sign_bit, distance_middle), distance_radius);
+    // The side planes through x (alpha >= 0, beta >= 0), the plane through the segment
+    // (s <= s_max) and the self-occlusion plane (s >= s_min).
     keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
     keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
     keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, s_min));
     keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, s_max));
-    for (int k = 0; k < 3; ++k) {
-      keep = _mm_and_ps(keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), region_upper[k]));
-      keep = _mm_and_ps(keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), region_lower[k]));
-    }
     int mask = _mm_movemask_ps(keep);
     if (mask == 0) continue;
 
