@@ -384,6 +384,10 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     }
   }
 
+  // Prefetch only when the structure is larger than a typical L2 cache.
+  const bool prefetch =
+      nodes_.size() * sizeof(Node) + triangles_.size() * sizeof(OccluderTriangle) >
+      (size_t{1} << 20);
   StackEntry stack[kStackCapacity];
   int top = 0;
   stack[top++] = {0, 0.0f, 1.0f};
@@ -428,6 +432,7 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
       keep = _mm_and_ps(keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), region_upper[k]));
       keep = _mm_and_ps(keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), region_lower[k]));
     }
+    if (_mm_movemask_ps(keep) == 0) continue;
     __m128 distance_middle, distance_radius;
     distance_range.evaluate(center, extent, distance_middle, distance_radius);
     keep =
@@ -487,7 +492,9 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
       int slot = order[i];
       uint32_t code = node.child[slot];
       stack[top++] = {code, t_lowers[slot], t_uppers[slot]};
-      // Start loading it now: the walk is bound by memory on large scenes.
+      // Start loading it now: the walk is bound by memory on large scenes (small ones stay in
+      // cache, and the prefetches would only cost instructions).
+      if (!prefetch) continue;
       if (code & kLeafFlag) {
         const char* leaf =
             reinterpret_cast<const char*>(&triangles_[(code & ~kLeafFlag) >> kCountBits]);
