@@ -91,7 +91,10 @@ LobeMoments ggx_lobe_moments(double alpha, double cos_theta, int n) {
   return moments;
 }
 
-Matrix3 ltc_matrix(const LtcParameters& p, const Vec3& z_axis) {
+Matrix3 ltc_matrix(const LtcParameters& p, const Vec3& average_direction) {
+  double c = std::cos(p[3]), s = std::sin(p[3]);
+  Vec3 z_axis{c * average_direction.x + s * average_direction.z, 0.0,
+              c * average_direction.z - s * average_direction.x};
   Vec3 y_axis{0, 1, 0};
   Vec3 x_axis = cross(y_axis, z_axis);
   Matrix3 frame;
@@ -110,7 +113,7 @@ double ltc_fit_error(const LinearlyTransformedCosine& ltc, double alpha, double 
 NelderMeadResult nelder_mead(const std::function<double(const LtcParameters&)>& f,
                              const LtcParameters& start, double step, int max_evaluations,
                              double tolerance) {
-  constexpr int kDimension = 3;
+  constexpr int kDimension = 4;
   std::array<LtcParameters, kDimension + 1> simplex;
   std::array<double, kDimension + 1> values;
   NelderMeadResult result;
@@ -131,7 +134,7 @@ NelderMeadResult nelder_mead(const std::function<double(const LtcParameters&)>& 
   };
   while (result.evaluations < max_evaluations) {
     // Order the vertices by value.
-    std::array<int, kDimension + 1> order{0, 1, 2, 3};
+    std::array<int, kDimension + 1> order{0, 1, 2, 3, 4};
     std::sort(order.begin(), order.end(), [&](int a, int b) { return values[a] < values[b]; });
     auto sorted_simplex = simplex;
     auto sorted_values = values;
@@ -142,7 +145,7 @@ NelderMeadResult nelder_mead(const std::function<double(const LtcParameters&)>& 
     if (std::abs(values[kDimension] - values[0]) <=
         tolerance * (std::abs(values[0]) + std::abs(values[kDimension])) + 1e-300)
       break;
-    LtcParameters centroid{0, 0, 0};
+    LtcParameters centroid{0, 0, 0, 0};
     for (int i = 0; i < kDimension; ++i)
       for (int k = 0; k < kDimension; ++k) centroid[k] += simplex[i][k] / kDimension;
     const LtcParameters& worst = simplex[kDimension];
@@ -181,24 +184,31 @@ NelderMeadResult nelder_mead(const std::function<double(const LtcParameters&)>& 
   return result;
 }
 
-CellFit fit_ggx_ltc_cell(double alpha, double cos_theta, const LtcParameters& initial,
+CellFit fit_ggx_ltc_cell(double alpha, double cos_theta, std::span<const LtcParameters> initials,
                          const FitOptions& options) {
   LobeMoments moments = ggx_lobe_moments(alpha, cos_theta, options.moment_samples_per_axis);
   CellFit fit;
   auto objective = [&](const LtcParameters& p) {
-    if (!(p[0] > 0) || !(p[1] > 0) || !std::isfinite(p[2])) return 1e300;
+    if (!(p[0] > 0) || !(p[1] > 0) || !std::isfinite(p[2]) || !(std::abs(p[3]) < 1.5)) return 1e300;
     LinearlyTransformedCosine ltc(ltc_matrix(p, moments.average_direction));
     return difference_integral(ltc, alpha, cos_theta, moments.albedo,
                                options.objective_samples_per_axis,
                                [](double d) { return d * d * d; });
   };
-  // Two rounds: a restart from the first minimum escapes a collapsed simplex.
-  NelderMeadResult first = nelder_mead(objective, initial, 0.05, options.max_evaluations, 1e-8);
-  NelderMeadResult second =
-      nelder_mead(objective, first.minimum, 0.02, options.max_evaluations / 2, 1e-10);
-  NelderMeadResult best = second.value <= first.value ? second : first;
+  // From each start two rounds (a restart from the first minimum escapes a collapsed simplex);
+  // the lowest objective wins.
+  NelderMeadResult best;
+  best.value = 1e300;
+  fit.evaluations = 0;
+  for (const LtcParameters& initial : initials) {
+    NelderMeadResult first = nelder_mead(objective, initial, 0.05, options.max_evaluations, 1e-8);
+    NelderMeadResult second =
+        nelder_mead(objective, first.minimum, 0.02, options.max_evaluations / 2, 1e-10);
+    fit.evaluations += first.evaluations + second.evaluations;
+    for (const NelderMeadResult* candidate : {&first, &second})
+      if (candidate->value < best.value) best = *candidate;
+  }
   fit.parameters = best.minimum;
-  fit.evaluations = first.evaluations + second.evaluations;
 
   Matrix3 m = ltc_matrix(fit.parameters, moments.average_direction);
   Matrix3 m_inverse = inverse(m);
@@ -226,16 +236,22 @@ std::vector<CellFit> fit_ggx_ltc_table(const FitOptions& options,
     double alpha = ggx_ltc_table_alpha(row);
     for (int column = 0; column < n; ++column) {
       double cos_theta = ggx_ltc_table_cos_theta(column);
-      LtcParameters initial{alpha, alpha, 0.0};
+      // Starts: the rougher neighbour's solution scaled to this roughness (Heitz et al.), and
+      // the same untilted. Narrow lobes need the second: a tilt that suited the rougher lobe
+      // can miss a narrow one entirely, where the objective is flat.
+      std::array<LtcParameters, 2> initials;
+      initials[0] = {alpha, alpha, 0.0, 0.0};
       if (row + 1 < n) {
-        // The rougher neighbour's solution, scaled to this roughness.
         const LtcParameters& rougher = table[size_t((row + 1) * n + column)].parameters;
         double ratio = alpha / ggx_ltc_table_alpha(row + 1);
-        initial = {rougher[0] * ratio, rougher[1] * ratio, rougher[2] * ratio};
+        initials[0] = {rougher[0] * ratio, rougher[1] * ratio, rougher[2] * ratio,
+                       rougher[3] * ratio};
       } else if (column > 0) {
-        initial = table[size_t(row * n + column - 1)].parameters;
+        initials[0] = table[size_t(row * n + column - 1)].parameters;
       }
-      table[size_t(row * n + column)] = fit_ggx_ltc_cell(alpha, cos_theta, initial, options);
+      initials[1] = initials[0];
+      initials[1][3] = 0.0;
+      table[size_t(row * n + column)] = fit_ggx_ltc_cell(alpha, cos_theta, initials, options);
     }
     if (progress) progress(row);
   }
