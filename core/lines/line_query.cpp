@@ -109,14 +109,14 @@ struct LinearRange4 {
   __m128 gradient[3], gradient_magnitude[3];
   __m128 offset, error;
 
-  LinearRange4(const Vec3& gradient_d, const Vec3& x, const Vec3& scene_max_abs) {
+  // `coordinate_bound` is max |p| over the scene plus |x|, per axis (computed once per query).
+  LinearRange4(const Vec3& gradient_d, const Vec3& x, const Vec3& coordinate_bound) {
     double offset_d = -dot(gradient_d, x);
     // Float error of evaluating dot(g, c) + offset and dot(|g|, e) with g, offset, c, e rounded
     // to float: a few ulps of the largest partial sum, bounded by |g|.(max |p| + |x|) since
     // centres and extents are bounded by the scene's extent; 32 ulps to be safe.
     Vec3 magnitude = absolute(gradient_d);
-    double error_d =
-        32 * (FLT_EPSILON / 2) * (dot(magnitude, scene_max_abs) + dot(magnitude, absolute(x)));
+    double error_d = 32 * (FLT_EPSILON / 2) * dot(magnitude, coordinate_bound);
     for (int k = 0; k < 3; ++k) {
       gradient[k] = _mm_set1_ps(static_cast<float>(gradient_d[k]));
       gradient_magnitude[k] = _mm_set1_ps(static_cast<float>(magnitude[k]));
@@ -349,12 +349,15 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
   // distance to the plane, alpha, beta and depth s = alpha + beta.
   // (The plane test is homogeneous in the normal: normalized, so that it stays far from float
   // denormals, which flush to zero, at any scene scale.)
-  const LinearRange4 distance_range(normalize(shadow->plane_normal), x, scene_max_abs_);
-  const LinearRange4 alpha_range(shadow->alpha_gradient, x, scene_max_abs_);
-  const LinearRange4 beta_range(shadow->beta_gradient, x, scene_max_abs_);
+  // One bound for all four error terms (|g|.(max |p| + |x|); double rounding of the sum is far
+  // below the 32-ulp float margin).
+  const Vec3 coordinate_bound = scene_max_abs_ + absolute(x);
+  const LinearRange4 distance_range(normalize(shadow->plane_normal), x, coordinate_bound);
+  const LinearRange4 alpha_range(shadow->alpha_gradient, x, coordinate_bound);
+  const LinearRange4 beta_range(shadow->beta_gradient, x, coordinate_bound);
   // Depth s = alpha + beta: its middle is the sum of theirs, so its error bound is the sum of
   // theirs too (plus its own, for the radius).
-  LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, scene_max_abs_);
+  LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, coordinate_bound);
   depth_range.error =
       _mm_add_ps(depth_range.error, _mm_add_ps(alpha_range.error, beta_range.error));
   const __m128 zero = _mm_setzero_ps();
