@@ -372,7 +372,8 @@ void add_fig13_rows(const ReproductionOptions& options, const RenderedSettings& 
     report.rows.push_back(row);
     std::string title = std::string("Fig. 13: ") + c.scene + " (" + c.sampling + ")";
     report.details.push_back(study_details(sweep, title));
-    report.charts.push_back({std::string("fig13-") + c.scene, sweep_chart(sweep, title)});
+    report.charts.push_back(
+        {std::string("fig13-") + c.scene, sweep_chart(sweep, std::string("Fig. 13: ") + c.scene)});
 
     if (c.disk_sampling == DiskSampling::SquareRejection) {
       // The renderer's own disk sampling (the concentric map) is not what the paper measured:
