@@ -92,7 +92,7 @@ TEST(Renderer, SecondsBudgetStopsAtAPassBoundary) {
 
 TEST(Renderer, RefusesMethodsItCannotRun) {
   auto scene = test_scene();
-  EXPECT_THROW(Renderer(scene, RenderOptions{"line-sa:v", Pattern::Random, 0}), FormatError);
+  EXPECT_THROW(Renderer(scene, RenderOptions{"line-sa:rand", Pattern::Random, 0}), FormatError);
   EXPECT_THROW(Renderer(scene, RenderOptions{"nope", Pattern::Random, 0}), FormatError);
 }
 
