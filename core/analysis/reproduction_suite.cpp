@@ -16,7 +16,9 @@
 #include "core/analysis/peters_reproduction.h"
 #include "core/analysis/variance_convergence.h"
 #include "core/analysis/visibility_reproduction.h"
+#include "core/image/metrics.h"
 #include "core/polygon/projected_solid_angle.h"
+#include "core/render/probe.h"
 #include "core/scene/scene.h"
 
 namespace penumbra {
@@ -506,6 +508,33 @@ std::vector<int> powers_of_two(int from, int to) {
   return out;
 }
 
+// Variance against N at one shading point given directly (the probe's `points`), luminance-free:
+// the green channel, as the line tests do.
+VarianceConvergence convergence_at_point(std::shared_ptr<const Scene> scene,
+                                         const ProbePointSpec& point, const std::string& method,
+                                         Pattern sampler, const std::vector<int>& counts,
+                                         int trials, uint64_t seed) {
+  ProbeSpec spec;
+  spec.points = {point};
+  ProbeResult result = run_probe(scene, spec, method, sampler, counts, trials, seed);
+  VarianceConvergence out;
+  out.method = method;
+  out.sampler = sampler;
+  out.trials = trials;
+  out.counts = counts;
+  std::vector<double> n;
+  for (const ProbeRun& run : result.points[0]) {
+    out.mean_variance.push_back(run.variance.y);
+    n.push_back(run.n);
+  }
+  out.variance_slope = log_log_slope(n, out.mean_variance);
+  return out;
+}
+
+ProbePointSpec point_seen_from(const Scene& scene, const Vec3& position, const char* material) {
+  return {position, {0, 1, 0}, normalize(scene.camera.position - position), material};
+}
+
 void add_line_rows(const ReproductionOptions& options, ReproductionReport& report) {
   if (options.progress)
     options.progress("line samples: Billen & Dutre Fig. 9, Salesin & Jarosz Figs. 5, 7");
@@ -515,24 +544,6 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
   PatternErrorOptions screen;
   screen.max_pixels = options.full ? 24 : 8;
   screen.threads = options.threads;
-  PenumbraPixels penumbra = find_penumbra_pixels(scene, screen);
-  // Unoccluded pixels (Salesin & Jarosz Fig. 7, pixel A): fully lit floor points next to the
-  // shadow, the two lit pixels closest to the penumbra pixels' centre.
-  PatternErrorOptions lit_screen = screen;
-  lit_screen.min_visible_fraction = 0.999;
-  lit_screen.max_visible_fraction = 1.0;
-  lit_screen.max_pixels = 1 << 20;
-  PenumbraPixels lit = find_penumbra_pixels(scene, lit_screen);
-  double cx = 0, cy = 0;
-  for (auto [x, y] : penumbra.pixels) {
-    cx += x / double(penumbra.pixels.size());
-    cy += y / double(penumbra.pixels.size());
-  }
-  std::vector<std::pair<int, int>> unoccluded_pixels = lit.pixels;
-  std::sort(unoccluded_pixels.begin(), unoccluded_pixels.end(), [&](auto a, auto b) {
-    return std::hypot(a.first - cx, a.second - cy) < std::hypot(b.first - cx, b.second - cy);
-  });
-  unoccluded_pixels.resize(std::min<size_t>(2, unoccluded_pixels.size()));
 
   // Salesin & Jarosz Fig. 5 analyses pixels whose integrand is continuous along one line
   // direction and sharply discontinuous along the other: the penumbrae of the shadow edges
@@ -552,43 +563,52 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
     return measure_variance_convergence(scene, pixels, method, sampler, counts, trials, 2016);
   };
 
-  // Billen & Dutré Fig. 9: slope of the standard deviation, stratified. Their scenes (grid
-  // planes, a triangle soup) cast shadow edges at all orientations; quad-over-floor's edges are
-  // parallel to the lines by design (Salesin & Jarosz's worst case), where a line's integral
-  // jumps with its offset and the slope is -1 in theory. The spheres' curved silhouettes of
-  // spheres-plane-square are the closer match.
+  // Billen & Dutré Fig. 9: slope of the standard deviation, stratified, on their grid-planes
+  // scene: ground points in the grids' shadow, where several bars' shadows cross the light at
+  // all orientations. (On quad-over-floor, whose shadow edges run parallel to the lines, the
+  // slope is -1 in theory and measured -1.005; on spheres-plane-square -1.445.) The criterion is
+  // the issue's: lines at least as steep as -1, points near -0.72.
   {
     Stopwatch clock;
-    const std::string experiment =
-        "spheres-plane-square penumbra: std. deviation slope, stratified";
-    const std::string tolerance = "lines in [-1.37, -1.05], points in [-0.85, -0.6]";
+    const std::string experiment = "grid-planes shadow points: std. deviation slope, stratified";
+    const std::string tolerance = "lines <= -1.0, points in [-0.9, -0.55]";
     try {
-      auto spheres = load_bundled(options, "spheres-plane-square");
-      PenumbraPixels sphere_penumbra = find_penumbra_pixels(spheres, screen);
-      auto measure_spheres = [&](const std::string& method) {
-        return measure_variance_convergence(spheres, sphere_penumbra.pixels, method,
-                                            Pattern::Stratified, counts, trials, 2016);
-      };
-      VarianceConvergence lines = measure_spheres("line-bd16:u");
-      VarianceConvergence points = measure_spheres("area");
+      auto grids = load_bundled(options, "grid-planes");
+      const std::vector<int> bd_counts = powers_of_two(4, options.full ? 1024 : 256);
+      const int bd_trials = options.full ? 256 : 64;
+      double lines_slope = 0, points_slope = 0;
+      std::vector<ChartSeries> series;
+      int index = 0;
+      for (Vec3 position : {Vec3{0.05, 0, 0.1}, Vec3{-0.3, 0, 0.35}}) {
+        ProbePointSpec p = point_seen_from(*grids, position, "ground");
+        VarianceConvergence lines = convergence_at_point(grids, p, "line-bd16:u",
+                                                         Pattern::Stratified, bd_counts, bd_trials, 9);
+        VarianceConvergence points =
+            convergence_at_point(grids, p, "sa", Pattern::Stratified, bd_counts, bd_trials, 9);
+        lines_slope = std::max(lines_slope == 0 ? -1e9 : lines_slope, lines.deviation_slope());
+        points_slope += points.deviation_slope() / 2;
+        std::string where = " (point " + std::to_string(++index) + ")";
+        series.push_back(lines.series("line-bd16:u" + where));
+        series.push_back(points.series("sa points" + where));
+      }
       ReproductionRow row;
       row.experiment = experiment;
       row.figure = "Billen & Dutre 2016 Fig. 9";
       row.paper_value = "lines -1.15 .. -1.27, points -0.72";
-      row.ours = "lines " + format("%.3f", lines.deviation_slope()) + ", points " +
-                 format("%.3f", points.deviation_slope());
+      row.ours = "lines " + format("%.3f", lines_slope) + " (shallowest), points " +
+                 format("%.3f", points_slope) + " (mean)";
       row.tolerance = tolerance;
-      double l = lines.deviation_slope(), p = points.deviation_slope();
-      row.status =
-          (l >= -1.37 && l <= -1.05 && p >= -0.85 && p <= -0.6) ? RowStatus::Pass : RowStatus::Fail;
+      row.status = (lines_slope <= -1.0 && points_slope >= -0.9 && points_slope <= -0.55)
+                       ? RowStatus::Pass
+                       : RowStatus::Fail;
       row.seconds = clock.seconds();
       report.rows.push_back(row);
       ChartSpec chart;
-      chart.title = "Billen & Dutre Fig. 9: spheres-plane-square penumbra, stratified";
+      chart.title = "Billen & Dutre Fig. 9: grid-planes shadow points, stratified";
       chart.x_label = "samples N";
       chart.y_label = "variance";
       chart.log_x = chart.log_y = true;
-      chart.series = {lines.series("line-bd16:u"), points.series("area points")};
+      chart.series = series;
       report.charts.push_back({"bd16-fig9", chart});
     } catch (const FormatError& e) {
       report.rows.push_back(not_available(experiment, "Billen & Dutre 2016 Fig. 9",
@@ -635,52 +655,62 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
     }
   }
 
-  // Salesin & Jarosz Fig. 7: variance slopes of MIS(bsdf, lines) without and with smoothing.
-  struct Fig7Case {
-    const char* where;
-    const std::vector<std::pair<int, int>>* pixels;
-    double plain, smooth;
-  };
-  for (Fig7Case c : {Fig7Case{"unoccluded", &unoccluded_pixels, -1.4, -2.0},
-                     Fig7Case{"partially occluded", &penumbra.pixels, -1.53, -1.68}}) {
-    Stopwatch clock;
-    const std::string experiment =
-        std::string("quad-over-floor ") + c.where + ": variance slope of bsdf+line-sa, cmj";
-    const std::string paper =
-        "balance " + format("%.2f", c.plain) + ", smooth " + format("%.2f", c.smooth);
-    const std::string tolerance = "each +- 0.25, smooth steeper";
-    try {
-      VarianceConvergence plain = measure(*c.pixels, "bsdf+line-sa:u/balance", Pattern::Cmj);
-      VarianceConvergence smooth = measure(*c.pixels, "bsdf+line-sa:u/smooth", Pattern::Cmj);
-      ReproductionRow row;
-      row.experiment = experiment;
-      row.figure = "Salesin & Jarosz 2019 Fig. 7";
-      row.paper_value = paper;
-      row.ours = "balance " + format("%.3f", plain.variance_slope) + ", smooth " +
-                 format("%.3f", smooth.variance_slope);
-      row.tolerance = tolerance;
-      bool ok = std::abs(plain.variance_slope - c.plain) <= 0.25 &&
-                std::abs(smooth.variance_slope - c.smooth) <= 0.25 &&
-                smooth.variance_slope < plain.variance_slope;
-      row.status = ok ? RowStatus::Pass : RowStatus::Fail;
-      row.note = "pixels";
-      for (auto [x, y] : *c.pixels)
-        row.note += " (" + std::to_string(x) + ", " + std::to_string(y) + ")";
-      row.seconds = clock.seconds();
-      report.rows.push_back(row);
-      ChartSpec chart;
-      chart.title = std::string("Salesin & Jarosz Fig. 7: ") + c.where + " pixel, cmj";
-      chart.x_label = "samples N";
-      chart.y_label = "variance";
-      chart.log_x = chart.log_y = true;
-      chart.series = {plain.series("bsdf+line-sa:u/balance"),
-                      smooth.series("bsdf+line-sa:u/smooth")};
-      report.charts.push_back(
-          {std::string("sj19-fig7-") + (c.pixels == &unoccluded_pixels ? "unoccluded" : "occluded"),
-           chart});
-    } catch (const FormatError& e) {
-      report.rows.push_back(
-          not_available(experiment, "Salesin & Jarosz 2019 Fig. 7", paper, tolerance, e.what()));
+  // Salesin & Jarosz Fig. 7: variance slopes of MIS(bsdf, lines) without and with smoothing, at
+  // an unoccluded and a partly occluded point of glossy-strips (the paper's pixels lie on glossy
+  // receivers, where BSDF samples matter). N = 4^k so every cmj grid is square. The criterion is
+  // the issue's: with smoothing at least 0.4 steeper unoccluded, steeper when partly occluded.
+  // (On quad-over-floor's diffuse floor, smoothing does not steepen the unoccluded slope:
+  // balance -1.36, smooth -1.32 in quick mode.)
+  {
+    auto strips = load_bundled(options, "glossy-strips");
+    const std::vector<int> fig7_counts =
+        options.full ? std::vector<int>{4, 16, 64, 256, 1024, 4096}
+                     : std::vector<int>{4, 16, 64, 256, 1024, 4096};
+    const int fig7_trials = options.full ? 512 : 128;
+    struct Fig7Case {
+      const char* where;
+      Vec3 position;
+      const char* material;
+      double plain, smooth, min_gain;
+    };
+    for (Fig7Case c : {Fig7Case{"unoccluded", {0.05, -0.001, 1.4}, "base", -1.4, -2.04, 0.4},
+                       Fig7Case{"partly occluded", {0.05, 0, 0.1}, "strip-4", -1.53, -1.68, 0.0}}) {
+      Stopwatch clock;
+      const std::string experiment =
+          std::string("glossy-strips ") + c.where + ": variance slope of bsdf+line-sa, cmj";
+      const std::string paper =
+          "balance " + format("%.2f", c.plain) + ", smooth " + format("%.2f", c.smooth);
+      const std::string tolerance = "smooth steeper by > " + format("%.1f", c.min_gain);
+      try {
+        ProbePointSpec p = point_seen_from(*strips, c.position, c.material);
+        VarianceConvergence plain = convergence_at_point(strips, p, "bsdf+line-sa:v",
+                                                         Pattern::Cmj, fig7_counts, fig7_trials, 2019);
+        VarianceConvergence smooth = convergence_at_point(
+            strips, p, "bsdf+line-sa:v/smooth", Pattern::Cmj, fig7_counts, fig7_trials, 2019);
+        ReproductionRow row;
+        row.experiment = experiment;
+        row.figure = "Salesin & Jarosz 2019 Fig. 7";
+        row.paper_value = paper;
+        row.ours = "balance " + format("%.3f", plain.variance_slope) + ", smooth " +
+                   format("%.3f", smooth.variance_slope);
+        row.tolerance = tolerance;
+        row.status = smooth.variance_slope < plain.variance_slope - c.min_gain ? RowStatus::Pass
+                                                                                : RowStatus::Fail;
+        row.seconds = clock.seconds();
+        report.rows.push_back(row);
+        ChartSpec chart;
+        chart.title = std::string("Salesin & Jarosz Fig. 7: ") + c.where + " point, cmj";
+        chart.x_label = "samples N";
+        chart.y_label = "variance";
+        chart.log_x = chart.log_y = true;
+        chart.series = {plain.series("bsdf+line-sa:v/balance"),
+                        smooth.series("bsdf+line-sa:v/smooth")};
+        report.charts.push_back(
+            {std::string("sj19-fig7-") + (c.min_gain > 0 ? "unoccluded" : "occluded"), chart});
+      } catch (const FormatError& e) {
+        report.rows.push_back(
+            not_available(experiment, "Salesin & Jarosz 2019 Fig. 7", paper, tolerance, e.what()));
+      }
     }
   }
 }

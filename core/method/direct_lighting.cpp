@@ -12,6 +12,7 @@
 #include "core/lines/line_sampling_solid_angle.h"
 #include "core/materials/bsdf.h"
 #include "core/method/smoothing.h"
+#include "core/polygon/ltc_strategy.h"
 #include "core/polygon/psa_strategy.h"
 #include "core/strategies/area_strategy.h"
 #include "core/strategies/bsdf_strategy.h"
@@ -24,7 +25,8 @@ namespace {
 // monostate: not prepared (never sampled or evaluated).
 using PreparedStrategy =
     std::variant<std::monostate, AreaStrategy, SolidAngleStrategy, BsdfStrategy,
-                 ProjectedSolidAngleStrategy, LineAreaStrategy, LineSolidAngleStrategy>;
+                 ProjectedSolidAngleStrategy, LtcStrategy, LineAreaStrategy,
+                 LineSolidAngleStrategy>;
 
 template <typename T>
 constexpr bool is_line_type =
@@ -94,6 +96,8 @@ PreparedStrategy prepare(const MethodTerm& term, const ShadingPoint& sp, const L
       return BsdfStrategy(sp, light);
     case StrategyKind::ProjectedSolidAngle:
       return ProjectedSolidAngleStrategy(sp, light);
+    case StrategyKind::Ltc:
+      return LtcStrategy(sp, light);
     default:
       break;
   }
@@ -371,14 +375,12 @@ DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
       case StrategyKind::Bsdf:
         break;
       case StrategyKind::ProjectedSolidAngle:
+      case StrategyKind::Ltc:
         for (size_t l = 0; l < scene.lights.size(); ++l)
           if (scene.lights[l].type == LightType::Disk)
-            refuse(method, "strategy \"psa\" samples polygons and quads; light " +
+            refuse(method, "strategy \"" + name + "\" samples polygons and quads; light " +
                                std::to_string(l) + " is a disk (use sa or area)");
         break;
-      case StrategyKind::Ltc:
-        refuse(method, "strategy \"" + name +
-                           "\" is not available yet (Peters 2021 LTC sampling, issue #4)");
       case StrategyKind::LineArea:
       case StrategyKind::LineSolidAngle:
         if (term.direction == LineDirection::Rand)

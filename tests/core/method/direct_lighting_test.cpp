@@ -138,7 +138,8 @@ INSTANTIATE_TEST_SUITE_P(
         UnbiasedCase{"area+2*sa/balance", Pattern::Random},
         UnbiasedCase{"area+bsdf+sa/power", Pattern::Random},
         UnbiasedCase{"4*sa", Pattern::Stratified}, UnbiasedCase{"4*area+4*bsdf", Pattern::Cmj},
-        UnbiasedCase{"psa", Pattern::Random}, UnbiasedCase{"bsdf+psa/power", Pattern::Random}),
+        UnbiasedCase{"psa", Pattern::Random}, UnbiasedCase{"bsdf+psa/power", Pattern::Random},
+        UnbiasedCase{"ltc", Pattern::Random}, UnbiasedCase{"ltc+bsdf+sa", Pattern::Random}),
     [](const auto& info) {
       std::string name = info.param.method;
       for (char& ch : name)
@@ -240,7 +241,7 @@ TEST(DirectLighting, FiniteInDegenerateConfigurations) {
 
 TEST(DirectLighting, RefusesWhatIsNotAvailableWithAClearError) {
   Scene scene = single_light_scene(test_lights()[0]);
-  for (const char* method : {"ltc"}) {
+  for (const char* method : {"psa+ltc/weighted", "psa+ltc/clamped-optimal"}) {
     try {
       DirectLighting direct(scene, parse_method(method));
       ADD_FAILURE() << method << " accepted";
