@@ -2,6 +2,7 @@
 // images stay bit-identical to a local render.
 // Built only with the farm (PENUMBRA_FARM=ON); otherwise the program reports a skipped test.
 #if __has_include("penumbra/v1/farm.pb.h")
+#include <cstdio>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -41,6 +42,12 @@ TEST(FarmFaults, KilledWorkerLeasesExpireAndOthersFinishBitIdentical) {
   }
   victim->signal(SIGKILL);
   victim->wait_exit(10s);
+  // Under load the victim may have delivered its last leased task just before the kill and
+  // not leased the next one yet: then no lease can expire. Ask the coordinator what it held
+  // (its leases stay in the table until they expire).
+  bool victim_held_leases = false;
+  for (const v1::WorkerInfo& worker : client.workers())
+    if (worker.name() == "victim") victim_held_leases = worker.tasks_leased() > 0;
   v1::JobStatus status = client.wait(job, 120s);
   ASSERT_EQ(status.state(), v1::JOB_STATE_DONE) << status.error();
   EXPECT_EQ(status.tasks_complete(), 24u * 16u);
@@ -49,9 +56,17 @@ TEST(FarmFaults, KilledWorkerLeasesExpireAndOthersFinishBitIdentical) {
   ASSERT_EQ(workers.size(), 2u);
   EXPECT_EQ(workers[0].tasks_completed() + workers[1].tasks_completed(), 24u * 16u)
       << "a task was counted twice or lost";
-  std::ifstream log(dir / "data" / "coordinator.log");
-  std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("lease of worker w"), std::string::npos) << "no lease expired";
+  std::string text;
+  for (int attempt = 0; attempt < 50; ++attempt) {  // the log is flushed per line; allow 5 s
+    std::ifstream log(dir / "data" / "coordinator.log");
+    text.assign(std::istreambuf_iterator<char>(log), std::istreambuf_iterator<char>());
+    if (text.find("lease of worker w") != std::string::npos) break;
+    std::this_thread::sleep_for(100ms);
+  }
+  if (victim_held_leases || text.find("lease of worker w") != std::string::npos)
+    EXPECT_NE(text.find("lease of worker w"), std::string::npos) << "no lease expired";
+  else
+    std::printf("note: the victim held no lease when it was killed; no expiry to check\n");
 }
 
 TEST(FarmFaults, TerminatedWorkerDrainsAndExitsCleanly) {
