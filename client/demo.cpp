@@ -199,7 +199,7 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
          << kReference.method << "` at " << reference.spp << " spp. MRSE (epsilon 1e-6) against "
          << "the reference over the image and the scene's regions.\n\n"
          << table << "\n";
-  if (!skipped.empty()) report << "Not run (not available yet):\n\n" << skipped;
+  if (!skipped.empty()) report << "Not run (refused by the estimator for this scene):\n\n" << skipped;
   std::printf("demo: wrote %s/report.md\n", out_dir.c_str());
 }
 
