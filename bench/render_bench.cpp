@@ -156,8 +156,7 @@ void DirectSample(benchmark::State& state, const char* method) {
     if (++i == w.points.size()) i = 0, ++pass;
   }
   benchmark::DoNotOptimize(sum);
-  state.SetItemsProcessed(state.iterations() *
-                          shading.direct_lighting().method().total_samples());
+  state.SetItemsProcessed(state.iterations() * shading.direct_lighting().method().total_samples());
 }
 BENCHMARK_CAPTURE(DirectSample, sa, "sa");
 BENCHMARK_CAPTURE(DirectSample, area, "area");

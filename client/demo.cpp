@@ -15,9 +15,9 @@
 
 #include "client/commands.h"
 #include "core/image/metrics.h"
+#include "core/method/direct_lighting.h"
 #include "core/method/method.h"
 #include "core/render/local_render.h"
-#include "core/method/direct_lighting.h"
 #include "core/scene/scene.h"
 
 #ifdef PENUMBRA_WITH_FARM
@@ -46,8 +46,15 @@ struct DemoEntry {
 
 // The comparison: point strategies, their MIS, and line strategies when they are available.
 const std::vector<DemoEntry> kDemoMethods{
-    {"area"}, {"sa"}, {"bsdf"}, {"bsdf+sa"}, {"line-sa:v"}, {"bsdf+line-sa:v/balance"},
-    {"bsdf+line-sa:v/smooth"}, {"line-bd16:rand"}, {"psa"},
+    {"area"},
+    {"sa"},
+    {"bsdf"},
+    {"bsdf+sa"},
+    {"line-sa:v"},
+    {"bsdf+line-sa:v/balance"},
+    {"bsdf+line-sa:v/smooth"},
+    {"line-bd16:rand"},
+    {"psa"},
 };
 const DemoEntry kReference{"bsdf+sa", "stratified"};
 
@@ -124,8 +131,7 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
   const std::string scene_path = bundled_scene_path("cornell-occluders");
   auto scene = std::make_shared<const Scene>(load_scene(scene_path));
   std::printf("demo: %s (%dx%d), %.1f s of compute per method, reference %.1f s\n",
-              scene->name.c_str(), scene->camera.width, scene->camera.height, seconds,
-              seconds * 8);
+              scene->name.c_str(), scene->camera.width, scene->camera.height, seconds, seconds * 8);
 
   DemoRenderer renderer(scene, scene_path, threads);
   auto render_one = [&](const DemoEntry& entry, double budget_seconds, uint64_t seed,
@@ -148,7 +154,8 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
   summary["scene"] = scene->name;
   summary["scene_hash"] = scene->content_hash;
   summary["seconds_per_method"] = seconds;
-  summary["reference"] = {{"method", kReference.method}, {"spp", reference.spp},
+  summary["reference"] = {{"method", kReference.method},
+                          {"spp", reference.spp},
                           {"compute_seconds", reference.compute_seconds}};
   summary["methods"] = nlohmann::json::array();
   std::string table = "| method | sampler | spp | compute s | MRSE image |";
@@ -172,12 +179,14 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
     auto errors = error_summary(result.film.color, reference.film.color, scene->regions);
     std::printf("  %-35s %6u spp %8.2f s  MRSE %.5g\n", entry.method.c_str(), result.spp,
                 result.compute_seconds, errors["image"].mrse);
-    nlohmann::json row{{"method", entry.method}, {"sampler", entry.sampler}, {"spp", result.spp},
+    nlohmann::json row{{"method", entry.method},
+                       {"sampler", entry.sampler},
+                       {"spp", result.spp},
                        {"compute_seconds", result.compute_seconds},
                        {"image", stem + ".exr"}};
     char cell[64];
-    table += "| `" + entry.method + "` | " + entry.sampler + " | " + std::to_string(result.spp) +
-             " | ";
+    table +=
+        "| `" + entry.method + "` | " + entry.sampler + " | " + std::to_string(result.spp) + " | ";
     std::snprintf(cell, sizeof cell, "%.2f", result.compute_seconds);
     table += cell;
     for (const auto& [name, e] : errors) {
@@ -195,11 +204,12 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
   std::ofstream(std::filesystem::path(out_dir) / "summary.json") << summary.dump(2) << "\n";
   std::ofstream report(std::filesystem::path(out_dir) / "report.md");
   report << "# Penumbra demo: " << scene->name << "\n\n"
-         << "Equal compute time per method (" << seconds << " s); reference `"
-         << kReference.method << "` at " << reference.spp << " spp. MRSE (epsilon 1e-6) against "
+         << "Equal compute time per method (" << seconds << " s); reference `" << kReference.method
+         << "` at " << reference.spp << " spp. MRSE (epsilon 1e-6) against "
          << "the reference over the image and the scene's regions.\n\n"
          << table << "\n";
-  if (!skipped.empty()) report << "Not run (refused by the estimator for this scene):\n\n" << skipped;
+  if (!skipped.empty())
+    report << "Not run (refused by the estimator for this scene):\n\n" << skipped;
   std::printf("demo: wrote %s/report.md\n", out_dir.c_str());
 }
 

@@ -62,8 +62,10 @@ void run_render(const RenderArgs& args) {
   RenderOptions options{args.method, sampler_from(args.sampler), args.seed};
   Renderer renderer(scene, options);
   RenderBudget budget;
-  if (args.seconds > 0) budget.seconds = args.seconds;
-  else budget.spp = args.spp;
+  if (args.seconds > 0)
+    budget.seconds = args.seconds;
+  else
+    budget.spp = args.spp;
   LocalRenderResult result = render_local(renderer, budget, args.threads, args.tile);
   if (result.film.nonfinite_samples > 0) {
     std::fprintf(stderr, "penumbra: error: %llu non-finite samples (counted as zero)\n",
@@ -102,23 +104,30 @@ std::vector<int> parse_counts(const std::string& text) {
 
 }  // namespace
 
-int command_exit_code() { return exit_code.load(); }
-void set_command_exit_code(int code) { exit_code.store(code); }
+int command_exit_code() {
+  return exit_code.load();
+}
+void set_command_exit_code(int code) {
+  exit_code.store(code);
+}
 
 void run_local_demo(const std::string& out_dir, double seconds_per_method, int threads);
 
 void add_local_commands(CLI::App& app) {
   // render
   auto args = std::make_shared<RenderArgs>();
-  CLI::App* render = app.add_subcommand("render", "Render a scene locally to an EXR (+ PNG preview)");
+  CLI::App* render =
+      app.add_subcommand("render", "Render a scene locally to an EXR (+ PNG preview)");
   render->add_option("scene", args->scene, "Scene file (penumbra/scene@1)")->required();
   render->add_option("--method,-m", args->method, "Method, e.g. sa or bsdf+sa/balance");
   render->add_option("--sampler,-s", args->sampler, "Sample pattern");
-  render->add_option("--spp", args->spp, "Samples (passes) per pixel")->check(CLI::Range(1u, 1u << 20));
+  render->add_option("--spp", args->spp, "Samples (passes) per pixel")
+      ->check(CLI::Range(1u, 1u << 20));
   render->add_option("--seconds", args->seconds, "Render progressively for this much compute time")
       ->check(CLI::PositiveNumber);
   render->add_option("--seed", args->seed, "Seed");
-  render->add_option("--threads", args->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+  render->add_option("--threads", args->threads, "Threads (0: all cores)")
+      ->check(CLI::Range(0, 1024));
   render->add_option("--tile", args->tile, "Tile size")->check(CLI::Range(1, 4096));
   render->add_option("-o,--output", args->output, "Output EXR");
   render->add_option("--reference", args->reference, "Reference EXR: print MRSE, per region too");
@@ -126,8 +135,7 @@ void add_local_commands(CLI::App& app) {
 
   // probe
   struct ProbeArgs {
-    std::string scene, probe, method = "sa", sampler = "stratified", samples = "1,2,4,8,16",
-                                output;
+    std::string scene, probe, method = "sa", sampler = "stratified", samples = "1,2,4,8,16", output;
     int trials = 64;
     uint64_t seed = 0;
   };
@@ -138,7 +146,8 @@ void add_local_commands(CLI::App& app) {
   probe->add_option("--method,-m", pargs->method, "Method");
   probe->add_option("--sampler,-s", pargs->sampler, "Sample pattern");
   probe->add_option("--samples", pargs->samples, "Sample counts N, comma-separated");
-  probe->add_option("--trials", pargs->trials, "Independent estimates per N")->check(CLI::Range(2, 1 << 24));
+  probe->add_option("--trials", pargs->trials, "Independent estimates per N")
+      ->check(CLI::Range(2, 1 << 24));
   probe->add_option("--seed", pargs->seed, "Seed");
   probe->add_option("--json", pargs->output, "Output file (default: standard output)");
   probe->callback([pargs] {
@@ -167,7 +176,8 @@ void add_local_commands(CLI::App& app) {
   CLI::App* demo = app.add_subcommand(
       "demo", "Render the bundled comparison on cornell-occluders at equal time, with a report");
   demo->add_option("-o,--output", dargs->output, "Output folder");
-  demo->add_option("--seconds", dargs->seconds, "Compute seconds per method")->check(CLI::PositiveNumber);
+  demo->add_option("--seconds", dargs->seconds, "Compute seconds per method")
+      ->check(CLI::PositiveNumber);
   demo->add_option("--threads", dargs->threads, "Threads (0: all cores)");
   demo->callback([dargs] { run_local_demo(dargs->output, dargs->seconds, dargs->threads); });
   add_reproduce_command(app);

@@ -32,17 +32,17 @@ EmbreeScene::EmbreeScene(const Scene& scene) : source_(&scene) {
 
   if (scene.triangle_count() > 0) {
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-        scene.positions.size()));
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), scene.positions.size()));
     for (size_t i = 0; i < scene.positions.size(); ++i) {
       vertices[i * 3 + 0] = float(scene.positions[i].x);
       vertices[i * 3 + 1] = float(scene.positions[i].y);
       vertices[i * 3 + 2] = float(scene.positions[i].z);
     }
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-        scene.triangle_count()));
+    auto* indices = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), scene.triangle_count()));
     std::copy(scene.indices.begin(), scene.indices.end(), indices);
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(scene_, geometry);

@@ -11,8 +11,8 @@
 namespace penumbra {
 
 struct RenderBudget {
-  uint32_t spp = 0;        // render exactly this many passes, or
-  double seconds = 0;      // pass blocks until this much compute (CPU) time is spent
+  uint32_t spp = 0;    // render exactly this many passes, or
+  double seconds = 0;  // pass blocks until this much compute (CPU) time is spent
   uint32_t max_spp = 1u << 20;
 };
 

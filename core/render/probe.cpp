@@ -31,8 +31,8 @@ ProbeSpec parse_probe(const std::string& text, const std::string& source) {
   if (!doc.is_object()) throw FormatError("$", source + ": expected an object");
   if (!doc.contains("format")) throw FormatError("$.format", "missing required key");
   if (doc["format"] != "penumbra/probe@1")
-    throw FormatError("$.format", "unknown format " + doc["format"].dump() +
-                                      "; expected \"penumbra/probe@1\"");
+    throw FormatError("$.format",
+                      "unknown format " + doc["format"].dump() + "; expected \"penumbra/probe@1\"");
   ProbeSpec probe;
   if (doc.contains("pixels")) {
     const json& pixels = doc["pixels"];
@@ -120,12 +120,12 @@ ProbeResult run_probe(std::shared_ptr<const Scene> scene, const ProbeSpec& probe
         StreamKey key{seed ^ (0x9E3779B97F4A7C15ull * uint64_t(n)), uint64_t(index),
                       uint32_t(trial), 0};
         const auto& hit = hits[index];
-        estimates[trial] = hit.shading_point
-                               ? shading.direct_lighting().estimate(*hit.shading_point, shading,
-                                                                    sampler, key, n)
-                               : hit.emitted;
+        estimates[trial] = hit.shading_point ? shading.direct_lighting().estimate(
+                                                   *hit.shading_point, shading, sampler, key, n)
+                                             : hit.emitted;
       }
-      double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       run.seconds_per_estimate = seconds / trials;
       for (const Rgb& e : estimates) run.mean += e;
       run.mean /= trials;

@@ -44,8 +44,8 @@ struct ProbeResult {
 
 // Throws FormatError for a bad method, a pixel outside the image, an unknown material.
 ProbeResult run_probe(std::shared_ptr<const Scene> scene, const ProbeSpec& probe,
-                      const std::string& method, Pattern sampler, std::span<const int> sample_counts,
-                      int trials, uint64_t seed);
+                      const std::string& method, Pattern sampler,
+                      std::span<const int> sample_counts, int trials, uint64_t seed);
 
 // `penumbra/probe-result@1` JSON.
 std::string probe_result_json(const ProbeResult& result);

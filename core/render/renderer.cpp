@@ -25,34 +25,39 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderOptions& opti
 
 Renderer::~Renderer() = default;
 
-const Scene& Renderer::scene() const { return impl_->shading.scene(); }
-const RenderOptions& Renderer::options() const { return impl_->options; }
+const Scene& Renderer::scene() const {
+  return impl_->shading.scene();
+}
+const RenderOptions& Renderer::options() const {
+  return impl_->options;
+}
 
 void Renderer::render_tile(const TileRect& tile, uint32_t pass_begin, uint32_t pass_end,
                            TileAccumulator& out) const {
   if (!(out.rect() == tile)) throw std::invalid_argument("render_tile: accumulator rect differs");
   const Scene& scene = impl_->shading.scene();
   const int width = scene.camera.width;
-  tbb::parallel_for(tbb::blocked_range<int>(tile.y0, tile.y1), [&](const tbb::blocked_range<int>& rows) {
-    // Embree wants flush-to-zero and denormals-are-zero on every thread that traces.
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      for (int x = tile.x0; x < tile.x1; ++x) {
-        int64_t local = int64_t(y - tile.y0) * tile.width() + (x - tile.x0);
-        StreamKey key{impl_->options.seed, uint64_t(y) * width + x, 0, kPixelJitterStream};
-        for (uint32_t pass = pass_begin; pass < pass_end; ++pass) {
-          key.pass = pass;
-          key.stream = kPixelJitterStream;
-          double jx = random_uniform(key, 0, 0), jy = random_uniform(key, 0, 1);
-          Vec3 direction = impl_->camera.direction(x + jx, y + jy);
-          Rgb radiance = impl_->shading.radiance(impl_->camera.origin(), direction,
-                                                 impl_->options.sampler, key);
-          out.add_sample(local, radiance);
+  tbb::parallel_for(
+      tbb::blocked_range<int>(tile.y0, tile.y1), [&](const tbb::blocked_range<int>& rows) {
+        // Embree wants flush-to-zero and denormals-are-zero on every thread that traces.
+        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+        for (int y = rows.begin(); y < rows.end(); ++y) {
+          for (int x = tile.x0; x < tile.x1; ++x) {
+            int64_t local = int64_t(y - tile.y0) * tile.width() + (x - tile.x0);
+            StreamKey key{impl_->options.seed, uint64_t(y) * width + x, 0, kPixelJitterStream};
+            for (uint32_t pass = pass_begin; pass < pass_end; ++pass) {
+              key.pass = pass;
+              key.stream = kPixelJitterStream;
+              double jx = random_uniform(key, 0, 0), jy = random_uniform(key, 0, 1);
+              Vec3 direction = impl_->camera.direction(x + jx, y + jy);
+              Rgb radiance = impl_->shading.radiance(impl_->camera.origin(), direction,
+                                                     impl_->options.sampler, key);
+              out.add_sample(local, radiance);
+            }
+          }
         }
-      }
-    }
-  });
+      });
 }
 
 std::vector<TileRect> cut_tiles(int width, int height, int tile_size) {

@@ -18,7 +18,7 @@
 namespace penumbra {
 
 struct RenderOptions {
-  std::string method = "sa";          // penumbra/method@1 text form
+  std::string method = "sa";  // penumbra/method@1 text form
   Pattern sampler = Pattern::Stratified;
   uint64_t seed = 0;
 };

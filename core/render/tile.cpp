@@ -7,9 +7,9 @@
 namespace penumbra {
 
 namespace {
-constexpr double kScale = 4294967296.0;  // 2^32
+constexpr double kScale = 4294967296.0;              // 2^32
 constexpr double kMaxValue = 1152921504606846976.0;  // 2^60
-constexpr uint32_t kMagic = 0x31544e50;  // "PNT1"
+constexpr uint32_t kMagic = 0x31544e50;              // "PNT1"
 
 template <typename T>
 void put(std::string& out, const T& value) {
@@ -30,7 +30,7 @@ T get(std::string_view& in) {
 Fixed128 to_fixed(double value) {
   value = std::clamp(value, -kMaxValue, kMaxValue);
   // Split into a high and a low part so the product with 2^32 is exact in 128 bits.
-  double scaled_high = std::floor(value) ;
+  double scaled_high = std::floor(value);
   double fraction = value - scaled_high;  // exact, in [0,1)
   Fixed128 high = static_cast<Fixed128>(static_cast<int64_t>(scaled_high)) << 32;
   Fixed128 low = static_cast<Fixed128>(std::llround(fraction * kScale));
@@ -40,7 +40,8 @@ Fixed128 to_fixed(double value) {
 double from_fixed(Fixed128 value) {
   bool negative = value < 0;
   unsigned __int128 magnitude = negative ? -static_cast<unsigned __int128>(value) : value;
-  double high = static_cast<double>(static_cast<uint64_t>(magnitude >> 64)) * 18446744073709551616.0;
+  double high =
+      static_cast<double>(static_cast<uint64_t>(magnitude >> 64)) * 18446744073709551616.0;
   double low = static_cast<double>(static_cast<uint64_t>(magnitude));
   double result = (high + low) / kScale;
   return negative ? -result : result;

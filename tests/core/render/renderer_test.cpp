@@ -153,7 +153,8 @@ TEST(Probe, BadInputGetsItsError) {
   EXPECT_THROW(parse_probe(R"({"format": "penumbra/probe@1"})"), FormatError);
   EXPECT_THROW(parse_probe(R"({"format": "penumbra/probe@1", "pixels": [[0]]})"), FormatError);
   try {
-    parse_probe(R"({"format": "penumbra/probe@1", "points": [{"position": [0,0,0], "normal": [0,1,0], "wo": [0,1,0]}]})");
+    parse_probe(
+        R"({"format": "penumbra/probe@1", "points": [{"position": [0,0,0], "normal": [0,1,0], "wo": [0,1,0]}]})");
     ADD_FAILURE();
   } catch (const FormatError& e) {
     EXPECT_EQ(e.json_path(), "$.points[0].material");
