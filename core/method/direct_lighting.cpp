@@ -134,8 +134,9 @@ Rgb unshadowed_integrand(const ShadingPoint& sp, const Light& light, const Vec3&
 
 // Can this light reach the shading point at all? (A planar emitter seen from behind or edge-on
 // contributes nothing; neither does a light entirely below the shading point's horizon.)
-bool light_faces_point(const ShadingPoint& sp, const Light& light) {
-  if (dot(light.normal, sp.position - light.centroid) <= 0) return false;
+bool light_reaches_point(const ShadingPoint& sp, const Light& light) {
+  // The emitting side, with the same tolerance the strategies use (core/lights).
+  if (!light_faces_point(light, sp.position)) return false;
   if (light.type == LightType::Disk) {
     // The disk's lowest point relative to the tangent plane.
     double height = dot(sp.normal, light.center - sp.position);
@@ -483,7 +484,7 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
   const size_t term_count = method_.terms.size();
   for (size_t l = 0; l < scene_->lights.size(); ++l) {
     const Light& light = scene_->lights[l];
-    if (!light_faces_point(sp, light)) continue;
+    if (!light_reaches_point(sp, light)) continue;
 
     // Prepare every term's strategy once for this shading point and light.
     PreparedTerms prepared;
