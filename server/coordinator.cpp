@@ -314,6 +314,7 @@ v1::SubmitJobResponse Coordinator::submit(const v1::JobSpec& request) {
     spdlog::info("{}: submitted: scene {} ({}x{}), method {}, sampler {}, {} tiles, priority {}",
                  job_name(id), scene->name, scene->camera.width, scene->camera.height,
                  spec.method(), spec.sampler(), j.tile_count, spec.priority());
+    ++counters_.jobs_submitted;
     response.set_job_id(job_name(id));
     response.set_scene_hash(scene->content_hash);
     collect_notifications(id, notifications);
@@ -506,6 +507,7 @@ v1::JobStatus Coordinator::status_locked(const Job& job, bool with_curve) const 
   status.set_state(v1::JobState(record.state));
   status.set_error(record.error);
   status.set_name(job.spec().name());
+  status.set_owner(job.spec().owner());
   status.set_priority(record.priority);
   status.set_scene_name(job.stored.scene_name());
   status.set_scene_hash(job.spec().scene_hash());
@@ -708,6 +710,7 @@ v1::LeaseTasksResponse Coordinator::lease_tasks(const v1::LeaseTasksRequest& req
       task->set_job_id(job_name(job.record.id));
       task->set_task_index(next->task_index);
       task->set_attempt_token(leases_.grant(*next, request.worker_id(), now));
+      ++counters_.tasks_leased;
       task->set_scene_hash(job.spec().scene_hash());
       task->set_method(job.spec().method());
       task->set_sampler(job.spec().sampler());
@@ -759,6 +762,7 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
     if (!lease || lease->task.job_id != job_id || lease->task.task_index != task_index) {
       spdlog::debug("{} task {}: late or duplicate result from {} dropped", request.job_id(),
                     task_index, request.worker_id());
+      ++counters_.late_results;
       return false;
     }
     Job& job = *jobs_.at(job_id);
@@ -772,6 +776,7 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
         throw invalid("tile: pixel " + std::to_string(i) + " has " + std::to_string(tile.count(i)) +
                       " samples, the task asked for " + std::to_string(pass_end - pass_begin));
     leases_.release(request.attempt_token());
+    ++counters_.tasks_completed;
     auto worker = workers_.find(request.worker_id());
     if (worker != workers_.end()) {
       ++worker->second.tasks_completed;
@@ -820,6 +825,7 @@ void Coordinator::fail_task(const v1::FailTaskRequest& request) {
     std::lock_guard lock(mutex_);
     auto lease = leases_.release(request.attempt_token());
     if (!lease) return;  // stale: the task was already handed to someone else
+    ++counters_.tasks_failed;
     Job& job = *jobs_.at(lease->task.job_id);
     int failures = ++job.failures[lease->task.task_index];
     spdlog::warn("{} task {}: failed on {} ({} of {}): {}", job_name(job.record.id),
@@ -849,7 +855,27 @@ void Coordinator::expire_leases() {
     spdlog::warn("{} task {}: lease of worker {} expired; task queued again",
                  job_name(lease.task.job_id), lease.task.task_index, lease.worker_id);
     scheduler_.requeue(lease.task);
+    ++counters_.leases_expired;
   }
+}
+
+Film Coordinator::preview_film(const std::string& job_id, uint32_t* passes) {
+  std::lock_guard lock(mutex_);
+  const Job& job = job_locked(job_id);
+  if (passes)
+    *passes =
+        job.record.blocks_sealed == 0
+            ? 0
+            : task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second;
+  return assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+}
+
+CoordinatorCounters Coordinator::counters() const {
+  std::lock_guard lock(mutex_);
+  CoordinatorCounters result = counters_;
+  result.queued_tasks = scheduler_.queued_total();
+  result.leased_tasks = leases_.size();
+  return result;
 }
 
 std::vector<v1::WorkerInfo> Coordinator::workers() {

@@ -50,6 +50,18 @@ struct CoordinatorOptions {
   std::string build_flavour;  // empty: penumbra::kBuildFlavour
 };
 
+// Monotonic counters and gauges for monitoring (Prometheus metrics, dashboards, benchmarks).
+struct CoordinatorCounters {
+  uint64_t tasks_leased = 0;     // leases granted since start
+  uint64_t tasks_completed = 0;  // results accepted
+  uint64_t tasks_failed = 0;     // FailTask calls that released a lease
+  uint64_t late_results = 0;     // late or duplicate results dropped
+  uint64_t leases_expired = 0;   // leases that timed out and were queued again
+  uint64_t jobs_submitted = 0;
+  uint64_t queued_tasks = 0;  // gauge: tasks waiting for a worker
+  uint64_t leased_tasks = 0;  // gauge: tasks held by workers now
+};
+
 // Parses a scene package without touching the filesystem. Throws FormatError.
 using SceneParser = std::function<Scene(const v1::ScenePackage&)>;
 
@@ -70,7 +82,11 @@ class Coordinator {
   std::string result_exr(const std::string& job_id);
   // The finished job's image (decoded from its EXR).
   Film result_film(const std::string& job_id);
+  // A running or finished job's image so far: the sealed pass blocks of every tile (tiles with
+  // none are black). For live previews; the pass count is returned in `passes`.
+  Film preview_film(const std::string& job_id, uint32_t* passes = nullptr);
   std::vector<v1::WorkerInfo> workers();
+  CoordinatorCounters counters() const;
 
   // Calls `on_change` (from any thread, never under the coordinator's lock) whenever the job's
   // status may have changed. Returns an id for unsubscribe.
@@ -131,6 +147,7 @@ class Coordinator {
   uint64_t next_worker_ = 1;
   std::map<uint64_t, std::pair<uint64_t, std::function<void()>>> subscriptions_;
   uint64_t next_subscription_ = 1;
+  CoordinatorCounters counters_;  // under mutex_; gauges filled in by counters()
 
   std::mutex expiry_mutex_;
   std::condition_variable expiry_wake_;

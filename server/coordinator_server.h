@@ -2,20 +2,35 @@
 // Starts the coordinator's gRPC server: jobs and workers services, health checking
 // (grpc.health.v1) and server reflection, on one address.
 
+#include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server.h>
+#include <grpcpp/server_builder.h>
 
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "server/coordinator.h"
 #include "server/services.h"
 
 namespace penumbra::farm {
 
+struct CoordinatorServerOptions {
+  std::string address = "127.0.0.1:7420";  // "host:port"; port 0 picks a free one
+  size_t max_message_bytes = size_t(272) << 20;
+  // Null: insecure (plain TCP). Set for TLS (server/main.cpp builds it from its flags).
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  // Called on the builder after the services are registered and before it starts: interceptors
+  // (authentication), further services, channel arguments.
+  std::vector<std::function<void(grpc::ServerBuilder&)>> configure;
+};
+
 class CoordinatorServer {
  public:
-  // Listens on `address` ("host:port"; port 0 picks a free one). Throws std::runtime_error when
-  // it cannot listen.
+  // Throws std::runtime_error when it cannot listen.
+  CoordinatorServer(Coordinator& coordinator, const CoordinatorServerOptions& options);
+  // Insecure, on `address`.
   CoordinatorServer(Coordinator& coordinator, const std::string& address, size_t max_message_bytes);
   ~CoordinatorServer();
   int port() const { return port_; }

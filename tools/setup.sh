@@ -8,7 +8,8 @@ packages=(
   libspdlog-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev libtinyobjloader-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   libplplot-dev plplot-driver-cairo fonts-dejavu-core
-  python3
+  python3 python3-yaml python3-jsonschema python3-prometheus-client
+  chromium iproute2 iptables nftables openssl
 )
 missing=()
 for p in "${packages[@]}"; do
