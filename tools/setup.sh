@@ -10,6 +10,7 @@ packages=(
   libplplot-dev plplot-driver-cairo fonts-dejavu-core
   python3 python3-yaml python3-jsonschema python3-prometheus-client
   chromium iproute2 iptables nftables openssl
+  libcpp-httplib-dev python3-kubernetes
 )
 missing=()
 for p in "${packages[@]}"; do
