@@ -3,7 +3,12 @@
 #include <grpcpp/client_context.h>
 #include <grpcpp/create_channel.h>
 #include <grpcpp/security/credentials.h>
+#include <grpcpp/support/client_interceptor.h>
 
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 namespace penumbra::farm {
@@ -50,18 +55,153 @@ std::string status_code_name(grpc::StatusCode code) {
   }
 }
 
-std::shared_ptr<grpc::Channel> make_farm_channel(const std::string& address) {
+namespace {
+
+grpc::ChannelArguments farm_channel_arguments() {
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(1 << 30);
   arguments.SetMaxSendMessageSize(1 << 30);
   arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
   arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
   arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
-  return grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), arguments);
+  return arguments;
+}
+
+std::string read_pem(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (in) text << in.rdbuf();
+  if (!in || text.str().empty()) throw std::runtime_error("cannot read the " + what + " " + path);
+  return text.str();
+}
+
+std::string trim(const std::string& text) {
+  const char* space = " \t\r\n";
+  size_t begin = text.find_first_not_of(space);
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(space) - begin + 1);
+}
+
+// Adds "authorization: Bearer <token>" to the initial metadata of every call.
+class BearerTokenInterceptor final : public grpc::experimental::Interceptor {
+ public:
+  explicit BearerTokenInterceptor(std::string header) : header_(std::move(header)) {}
+  void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
+    if (methods->QueryInterceptionHookPoint(
+            grpc::experimental::InterceptionHookPoints::PRE_SEND_INITIAL_METADATA))
+      methods->GetSendInitialMetadata()->emplace("authorization", header_);
+    methods->Proceed();
+  }
+
+ private:
+  std::string header_;
+};
+
+class BearerTokenInterceptorFactory final
+    : public grpc::experimental::ClientInterceptorFactoryInterface {
+ public:
+  explicit BearerTokenInterceptorFactory(const std::string& token) : header_("Bearer " + token) {}
+  grpc::experimental::Interceptor* CreateClientInterceptor(
+      grpc::experimental::ClientRpcInfo*) override {
+    return new BearerTokenInterceptor(header_);
+  }
+
+ private:
+  std::string header_;
+};
+
+}  // namespace
+
+std::shared_ptr<grpc::Channel> make_farm_channel(const std::string& address) {
+  return grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(),
+                                   farm_channel_arguments());
+}
+
+bool is_loopback_address(const std::string& address) {
+  std::string target = address;
+  for (const char* scheme : {"dns:///", "dns:", "ipv4:", "ipv6:"})
+    if (target.rfind(scheme, 0) == 0) {
+      target = target.substr(std::string(scheme).size());
+      break;
+    }
+  if (target.rfind("unix:", 0) == 0 || target.rfind("unix-abstract:", 0) == 0) return true;
+  std::string host;
+  if (!target.empty() && target.front() == '[') {
+    size_t close = target.find(']');
+    if (close == std::string::npos) return false;
+    host = target.substr(1, close - 1);
+  } else {
+    size_t colon = target.rfind(':');
+    host = colon == std::string::npos ? target : target.substr(0, colon);
+    // A bare IPv6 address without a port ("::1").
+    if (std::count(target.begin(), target.end(), ':') > 1) host = target;
+  }
+  std::transform(host.begin(), host.end(), host.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  if (host == "localhost" || host == "::1" || host == "0:0:0:0:0:0:0:1") return true;
+  // 127.0.0.0/8, written as a dotted quad.
+  if (host.rfind("127.", 0) != 0) return false;
+  int dots = 0;
+  for (char c : host) {
+    if (c == '.')
+      ++dots;
+    else if (c < '0' || c > '9')
+      return false;
+  }
+  return dots == 3;
+}
+
+std::string resolve_token(const std::string& token, const std::string& token_file) {
+  if (!token.empty()) return token;
+  if (!token_file.empty()) {
+    std::ifstream in(token_file);
+    std::string line;
+    if (!in || !std::getline(in, line) || trim(line).empty())
+      throw std::runtime_error("cannot read a token from " + token_file);
+    return trim(line);
+  }
+  const char* env = std::getenv("PENUMBRA_TOKEN");
+  return env ? trim(env) : std::string();
+}
+
+std::shared_ptr<grpc::Channel> make_farm_channel(const FarmConnection& connection) {
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  if (connection.uses_tls()) {
+    grpc::SslCredentialsOptions ssl;
+    if (!connection.tls_ca.empty()) ssl.pem_root_certs = read_pem(connection.tls_ca, "CA file");
+    if (connection.tls_cert.empty() != connection.tls_key.empty())
+      throw std::runtime_error(
+          "mutual TLS needs both a certificate (--tls-cert) and its key "
+          "(--tls-key)");
+    if (!connection.tls_cert.empty()) {
+      ssl.pem_cert_chain = read_pem(connection.tls_cert, "certificate");
+      ssl.pem_private_key = read_pem(connection.tls_key, "private key");
+    }
+    credentials = grpc::SslCredentials(ssl);
+  } else {
+    if (!connection.token.empty() && !is_loopback_address(connection.address))
+      throw std::runtime_error(
+          "refusing to send a token in plaintext to " + connection.address +
+          ": use TLS (--tls-ca) or a loopback address (127.0.0.1, localhost, ::1)");
+    credentials = grpc::InsecureChannelCredentials();
+  }
+  if (connection.token.empty())
+    return grpc::CreateCustomChannel(connection.address, credentials, farm_channel_arguments());
+  if (connection.token.find_first_of("\r\n") != std::string::npos)
+    throw std::runtime_error("the token contains a line break");
+  std::vector<std::unique_ptr<grpc::experimental::ClientInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(std::make_unique<BearerTokenInterceptorFactory>(connection.token));
+  return grpc::experimental::CreateCustomChannelWithInterceptors(
+      connection.address, credentials, farm_channel_arguments(), std::move(interceptors));
 }
 
 FarmClient::FarmClient(const std::string& address)
     : address_(address), channel_(make_farm_channel(address)), stub_(v1::Jobs::NewStub(channel_)) {}
+
+FarmClient::FarmClient(const FarmConnection& connection)
+    : address_(connection.address),
+      channel_(make_farm_channel(connection)),
+      stub_(v1::Jobs::NewStub(channel_)) {}
 
 namespace {
 

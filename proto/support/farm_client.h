@@ -2,6 +2,12 @@
 // A client of the coordinator's jobs service: what `penumbra submit/watch/...`, the embedded
 // farm and the tests use. Failed calls throw FarmCallError with the gRPC code and a readable
 // message.
+//
+// Connections: make_farm_channel(FarmConnection) opens TLS (server authentication with a CA
+// file, mutual TLS with a client certificate) or plaintext, and adds the bearer token to every
+// call made on the channel ("authorization: Bearer <token>" metadata, added by a client
+// interceptor, so it works with and without TLS). A token is refused over plaintext to any host
+// but a loopback one (it would travel in the clear).
 
 #include <grpcpp/channel.h>
 
@@ -28,12 +34,37 @@ class FarmCallError : public std::runtime_error {
 
 // "NOT_FOUND", "INVALID_ARGUMENT", ...
 std::string status_code_name(grpc::StatusCode code);
+
+// How to reach and authenticate to a coordinator. Paths name PEM files.
+struct FarmConnection {
+  std::string address;   // "host:port"
+  std::string tls_ca;    // CA certificate(s) that signed the coordinator's; set: TLS
+  std::string tls_cert;  // this client's certificate, for mutual TLS (with tls_key); set: TLS
+  std::string tls_key;   // this client's private key
+  std::string token;     // bearer token; empty: none (the coordinator has authentication off)
+  bool tls = false;      // TLS with the system's root certificates when tls_ca is empty
+  bool uses_tls() const { return tls || !tls_ca.empty() || !tls_cert.empty(); }
+};
+
 // Channel arguments shared by the farm's clients: large messages, quick reconnection.
+// Plaintext, no token.
 std::shared_ptr<grpc::Channel> make_farm_channel(const std::string& address);
+// TLS when connection.uses_tls(); the token (if any) on every call. Throws std::runtime_error for
+// a token over plaintext to a host that is not loopback, an unreadable PEM file, or a certificate
+// without its key.
+std::shared_ptr<grpc::Channel> make_farm_channel(const FarmConnection& connection);
+
+// True for localhost, 127.0.0.0/8, ::1 and unix: addresses.
+bool is_loopback_address(const std::string& address);
+
+// The token to use: `token` when set, else the first line of `token_file` (trimmed; throws when
+// the file cannot be read or is empty), else the environment variable PENUMBRA_TOKEN, else "".
+std::string resolve_token(const std::string& token, const std::string& token_file);
 
 class FarmClient {
  public:
   explicit FarmClient(const std::string& address);
+  explicit FarmClient(const FarmConnection& connection);
 
   v1::SubmitJobResponse submit(const v1::JobSpec& spec);
   v1::JobStatus status(const std::string& job_id);
