@@ -11,6 +11,7 @@
 #include "proto/support/scene_packing.h"
 #include "proto/support/shutdown_signals.h"
 #include "server/coordinator_server.h"
+#include "server/http_frontend.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"penumbra-coordinator: the Penumbra render farm's coordinator"};
@@ -32,6 +33,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-scene-mib", max_scene_mib, "largest scene package accepted");
   app.add_option("--max-queued-tasks", options.max_queued_tasks, "queue limit over all jobs");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error");
+  std::string http_listen;  // empty: no HTTP endpoint
+  app.add_option("--http-listen", http_listen,
+                 "serve /metrics, /healthz, /api and the dashboard on HOST:PORT (PORT or :PORT: "
+                 "loopback; off when not given)");
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_level(spdlog::level::from_str(log_level));
@@ -48,6 +53,13 @@ int main(int argc, char** argv) {
     penumbra::farm::CoordinatorServer server(coordinator, listen,
                                              options.max_scene_bytes + (size_t(16) << 20));
     spdlog::info("penumbra-coordinator listening on port {} (data in {})", server.port(), data_dir);
+    std::unique_ptr<penumbra::farm::HttpFrontend> http;
+    if (!http_listen.empty()) {
+      http = std::make_unique<penumbra::farm::HttpFrontend>(
+          coordinator, penumbra::farm::HttpFrontendOptions{.address = http_listen});
+      spdlog::info("penumbra-coordinator HTTP (metrics, dashboard) on {}:{}", http->host(),
+                   http->port());
+    }
     if (!port_file.empty()) {
       std::string temporary = port_file + ".tmp";
       std::ofstream(temporary) << server.port() << "\n";
