@@ -1,6 +1,8 @@
 // The client's farm commands: submit, watch, list, status, cancel, fetch, workers. Each talks to
 // the coordinator named by --coordinator or PENUMBRA_COORDINATOR through the jobs API
-// (proto/support/farm_client.h); gRPC errors reach the user as "CODE: what to fix".
+// (proto/support/farm_client.h), with TLS (--tls-ca or PENUMBRA_TLS_CA, mutual with
+// --tls-cert/--tls-key) and a token (--token, --token-file or PENUMBRA_TOKEN) when given;
+// gRPC errors reach the user as "CODE: what to fix".
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -24,15 +26,41 @@ namespace {
 
 using farm::FarmClient;
 
-std::string default_coordinator() {
-  const char* env = std::getenv("PENUMBRA_COORDINATOR");
-  return env && *env ? env : "127.0.0.1:7420";
+std::string environment(const char* name, const std::string& fallback = "") {
+  const char* value = std::getenv(name);
+  return value && *value ? value : fallback;
 }
 
-void add_coordinator_option(CLI::App* command, std::string& coordinator) {
-  command->add_option("--coordinator", coordinator,
+// Where the coordinator is and how to authenticate to it.
+struct ConnectionArguments {
+  std::string coordinator = environment("PENUMBRA_COORDINATOR", "127.0.0.1:7420");
+  std::string tls_ca = environment("PENUMBRA_TLS_CA");
+  std::string tls_cert, tls_key, token, token_file;
+};
+
+void add_connection_options(CLI::App* command, ConnectionArguments& connection) {
+  command->add_option("--coordinator", connection.coordinator,
                       "host:port of the coordinator (default: PENUMBRA_COORDINATOR or "
                       "127.0.0.1:7420)");
+  command->add_option("--tls-ca", connection.tls_ca,
+                      "PEM file of the CA that signed the coordinator's certificate: connect "
+                      "with TLS (default: PENUMBRA_TLS_CA)");
+  command->add_option("--tls-cert", connection.tls_cert,
+                      "PEM client certificate, for mutual TLS (with --tls-key)");
+  command->add_option("--tls-key", connection.tls_key, "PEM private key of --tls-cert");
+  command->add_option("--token", connection.token,
+                      "bearer token (visible in ps: prefer --token-file or PENUMBRA_TOKEN)");
+  command->add_option("--token-file", connection.token_file, "file whose first line is the token");
+}
+
+FarmClient connect(const ConnectionArguments& arguments) {
+  farm::FarmConnection connection;
+  connection.address = arguments.coordinator;
+  connection.tls_ca = arguments.tls_ca;
+  connection.tls_cert = arguments.tls_cert;
+  connection.tls_key = arguments.tls_key;
+  connection.token = farm::resolve_token(arguments.token, arguments.token_file);
+  return FarmClient(connection);
 }
 
 std::string state_name(v1::JobState state) {
@@ -139,7 +167,7 @@ std::string read_file(const std::string& path) {
 }
 
 struct SubmitArguments {
-  std::string coordinator = default_coordinator();
+  ConnectionArguments connection;
   std::string scene, method = "sa", sampler = "stratified", reference, name;
   uint32_t spp = 0;
   double seconds = 0;
@@ -171,7 +199,7 @@ void submit(const SubmitArguments& arguments) {
     else
       spec.set_reference_job(arguments.reference);
   }
-  FarmClient client(arguments.coordinator);
+  FarmClient client = connect(arguments.connection);
   v1::SubmitJobResponse response = client.submit(spec);
   std::printf("%s submitted (scene %s)\n", response.job_id().c_str(),
               response.scene_hash().substr(0, 12).c_str());
@@ -233,11 +261,11 @@ void add_farm_commands(CLI::App& app) {
                              "Passes in one task (8)");
   submit_command->add_option("--name", submit_arguments->name, "A label for the job");
   submit_command->add_flag("--wait", submit_arguments->wait, "Watch the job until it ends");
-  add_coordinator_option(submit_command, submit_arguments->coordinator);
+  add_connection_options(submit_command, submit_arguments->connection);
   submit_command->callback([submit_arguments] { submit(*submit_arguments); });
 
   struct JobArguments {
-    std::string coordinator = default_coordinator();
+    ConnectionArguments connection;
     std::string job;
     std::string output;
   };
@@ -245,27 +273,27 @@ void add_farm_commands(CLI::App& app) {
                             std::shared_ptr<JobArguments> arguments) {
     CLI::App* command = app.add_subcommand(name, description);
     command->add_option("job", arguments->job, "Job id (job-N)")->required();
-    add_coordinator_option(command, arguments->coordinator);
+    add_connection_options(command, arguments->connection);
     return command;
   };
 
   auto watch_arguments = std::make_shared<JobArguments>();
   job_command("watch", "Follow a job's progress: spp, tiles, ETA, current MRSE", watch_arguments)
       ->callback([watch_arguments] {
-        FarmClient client(watch_arguments->coordinator);
+        FarmClient client = connect(watch_arguments->connection);
         watch_job(client, watch_arguments->job);
       });
 
   auto status_arguments = std::make_shared<JobArguments>();
   job_command("status", "Show a job: state, progress, MRSE curve, errors", status_arguments)
       ->callback([status_arguments] {
-        FarmClient client(status_arguments->coordinator);
+        FarmClient client = connect(status_arguments->connection);
         print_status(client.status(status_arguments->job));
       });
 
   auto cancel_arguments = std::make_shared<JobArguments>();
   job_command("cancel", "Cancel a job", cancel_arguments)->callback([cancel_arguments] {
-    FarmClient client(cancel_arguments->coordinator);
+    FarmClient client = connect(cancel_arguments->connection);
     v1::JobState state = client.cancel(cancel_arguments->job);
     std::printf("%s %s\n", cancel_arguments->job.c_str(), state_name(state).c_str());
   });
@@ -275,7 +303,7 @@ void add_farm_commands(CLI::App& app) {
       "fetch", "Download a finished job's EXR (RGB, variance, metadata)", fetch_arguments);
   fetch_command->add_option("-o,--output", fetch_arguments->output, "Output EXR path")->required();
   fetch_command->callback([fetch_arguments] {
-    FarmClient client(fetch_arguments->coordinator);
+    FarmClient client = connect(fetch_arguments->connection);
     std::string bytes = client.fetch(fetch_arguments->job);
     std::string temporary = fetch_arguments->output + ".part";
     {
@@ -288,11 +316,11 @@ void add_farm_commands(CLI::App& app) {
                 fetch_arguments->output.c_str(), bytes.size());
   });
 
-  auto list_coordinator = std::make_shared<std::string>(default_coordinator());
+  auto list_connection = std::make_shared<ConnectionArguments>();
   CLI::App* list_command = app.add_subcommand("list", "List the farm's jobs");
-  add_coordinator_option(list_command, *list_coordinator);
-  list_command->callback([list_coordinator] {
-    FarmClient client(*list_coordinator);
+  add_connection_options(list_command, *list_connection);
+  list_command->callback([list_connection] {
+    FarmClient client = connect(*list_connection);
     std::printf("%-9s %-10s %4s %-20s %-16s %-10s %9s %10s %10s\n", "JOB", "STATE", "PRIO", "SCENE",
                 "METHOD", "BUDGET", "SPP", "COMPUTE s", "MRSE");
     for (const v1::JobStatus& job : client.list()) {
@@ -305,11 +333,11 @@ void add_farm_commands(CLI::App& app) {
     }
   });
 
-  auto workers_coordinator = std::make_shared<std::string>(default_coordinator());
+  auto workers_connection = std::make_shared<ConnectionArguments>();
   CLI::App* workers_command = app.add_subcommand("workers", "List the farm's workers");
-  add_coordinator_option(workers_command, *workers_coordinator);
-  workers_command->callback([workers_coordinator] {
-    FarmClient client(*workers_coordinator);
+  add_connection_options(workers_command, *workers_connection);
+  workers_command->callback([workers_connection] {
+    FarmClient client = connect(*workers_connection);
     std::printf("%-24s %-6s %7s %7s %10s %11s %s\n", "WORKER", "ALIVE", "THREADS", "LEASED",
                 "COMPLETED", "COMPUTE s", "LAST SEEN");
     for (const v1::WorkerInfo& worker : client.workers())

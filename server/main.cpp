@@ -1,5 +1,7 @@
 // penumbra-coordinator: serves the farm's jobs and workers APIs.
 //   penumbra-coordinator --listen 0.0.0.0:7420 --data-dir /var/lib/penumbra
+//       --tls-cert server.pem --tls-key server.key --tokens-file tokens.txt
+// Without --listen it serves 127.0.0.1:7420 (loopback only).
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -8,21 +10,26 @@
 #include <fstream>
 #include <thread>
 
+#include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
 #include "proto/support/shutdown_signals.h"
+#include "server/auth.h"
 #include "server/coordinator_server.h"
 #include "server/http_frontend.h"
+#include "server/tls.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"penumbra-coordinator: the Penumbra render farm's coordinator"};
-  std::string listen = "0.0.0.0:7420";
+  std::string listen = "127.0.0.1:7420";
   std::string data_dir = "penumbra-data";
   std::string port_file;
   std::string log_level = "info";
   double lease_seconds = 30;
   penumbra::farm::CoordinatorOptions options;
   size_t max_scene_mib = 256;
-  app.add_option("--listen", listen, "host:port to serve on (port 0: any free port)");
+  app.add_option("--listen", listen,
+                 "host:port to serve on (default 127.0.0.1:7420, loopback only; port 0: any free "
+                 "port)");
   app.add_option("--data-dir", data_dir, "folder of the SQLite state (created when missing)");
   app.add_option("--port-file", port_file, "write the port it listens on to this file");
   app.add_option("--lease-seconds", lease_seconds, "a lease not extended this long expires")
@@ -33,6 +40,18 @@ int main(int argc, char** argv) {
   app.add_option("--max-scene-mib", max_scene_mib, "largest scene package accepted");
   app.add_option("--max-queued-tasks", options.max_queued_tasks, "queue limit over all jobs");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error");
+  std::string tokens_file;
+  penumbra::farm::ServerTlsFiles tls;
+  penumbra::farm::ClientLimits client_limits;
+  app.add_option("--tokens-file", tokens_file,
+                 "lines \"role name token\" (roles client, worker, admin; # comments): require "
+                 "a token on every call (without it authentication is off)");
+  app.add_option("--tls-cert", tls.cert, "PEM certificate (chain) of this coordinator: serve TLS");
+  app.add_option("--tls-key", tls.key, "PEM private key of --tls-cert");
+  app.add_option("--tls-client-ca", tls.client_ca,
+                 "PEM CA of client certificates: mutual TLS, required of workers");
+  app.add_option("--max-queued-jobs-per-client", client_limits.max_queued_jobs_per_owner,
+                 "unfinished jobs one client (token name) may have (0: no limit)");
   std::string http_listen;  // empty: no HTTP endpoint
   app.add_option("--http-listen", http_listen,
                  "serve /metrics, /healthz, /api and the dashboard on HOST:PORT (PORT or :PORT: "
@@ -50,8 +69,34 @@ int main(int argc, char** argv) {
 
   try {
     penumbra::farm::Coordinator coordinator(options, penumbra::farm::parse_wire_package);
-    penumbra::farm::CoordinatorServer server(coordinator, listen,
-                                             options.max_scene_bytes + (size_t(16) << 20));
+    penumbra::farm::CoordinatorServerOptions server_options;
+    server_options.address = listen;
+    server_options.max_message_bytes = options.max_scene_bytes + (size_t(16) << 20);
+    penumbra::farm::AuthPolicy auth;
+    if (!tls.cert.empty() || !tls.key.empty() || !tls.client_ca.empty()) {
+      server_options.credentials = penumbra::farm::make_server_tls_credentials(tls);
+      auth.workers_need_client_certificate = !tls.client_ca.empty();
+    } else if (!penumbra::farm::is_loopback_address(listen)) {
+      spdlog::warn("serving {} without TLS: calls (and tokens) travel in the clear", listen);
+    }
+    if (!tokens_file.empty()) {
+      auth.tokens = std::make_shared<const penumbra::farm::TokenTable>(
+          penumbra::farm::TokenTable::load(tokens_file));
+      spdlog::info("authentication on: {} tokens from {}", auth.tokens->size(), tokens_file);
+    } else {
+      spdlog::warn(
+          "authentication off (no --tokens-file): anyone who can connect may submit "
+          "jobs and lease tasks");
+    }
+    if (auth.tokens || auth.workers_need_client_certificate)
+      server_options.configure.push_back([auth](grpc::ServerBuilder& builder) {
+        std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>>
+            interceptors;
+        interceptors.push_back(std::make_unique<penumbra::farm::AuthInterceptorFactory>(auth));
+        builder.experimental().SetInterceptorCreators(std::move(interceptors));
+      });
+    penumbra::farm::set_client_limits(client_limits);
+    penumbra::farm::CoordinatorServer server(coordinator, server_options);
     spdlog::info("penumbra-coordinator listening on port {} (data in {})", server.port(), data_dir);
     std::unique_ptr<penumbra::farm::HttpFrontend> http;
     if (!http_listen.empty()) {

@@ -3,19 +3,51 @@
 #include <algorithm>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <string>
 
+#include "server/auth.h"
 #include "server/grpc_status.h"
 
 namespace penumbra::farm {
 
 namespace {
 
+struct ClientLimitsState {
+  std::mutex mutex;
+  ClientLimits limits;
+};
+
+ClientLimitsState& client_limits_state() {
+  static ClientLimitsState state;
+  return state;
+}
+
+// The auth interceptor's refusal of this call (server/auth.h), if it refused it. The interceptor
+// has already ended the call with that status; the handler only stops here.
+std::optional<grpc::Status> refusal(const grpc::CallbackServerContext* context) {
+  std::optional<CallAuthorization> authorization = call_authorization(context);
+  if (authorization && !authorization->status.ok()) return authorization->status;
+  return std::nullopt;
+}
+
 template <typename Body>
 grpc::ServerUnaryReactor* unary(grpc::CallbackServerContext* context, Body&& body) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  reactor->Finish(handle(std::forward<Body>(body)));
+  if (std::optional<grpc::Status> refused = refusal(context))
+    reactor->Finish(*refused);
+  else
+    reactor->Finish(handle(std::forward<Body>(body)));
   return reactor;
 }
+
+// A streaming call refused before it started.
+template <typename Message>
+class RefusedWriteReactor final : public grpc::ServerWriteReactor<Message> {
+ public:
+  explicit RefusedWriteReactor(const grpc::Status& status) { this->Finish(status); }
+  void OnDone() override { delete this; }
+};
 
 bool is_terminal(v1::JobState state) {
   return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED ||
@@ -157,10 +189,44 @@ class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
 
 }  // namespace
 
+void set_client_limits(const ClientLimits& limits) {
+  std::lock_guard lock(client_limits_state().mutex);
+  client_limits_state().limits = limits;
+}
+
 grpc::ServerUnaryReactor* JobsService::SubmitJob(grpc::CallbackServerContext* context,
                                                  const v1::SubmitJobRequest* request,
                                                  v1::SubmitJobResponse* response) {
-  return unary(context, [&] { *response = coordinator_.submit(request->spec()); });
+  return unary(context, [&] {
+    // The owner is whoever authenticated (empty with authentication off), never what the
+    // request says.
+    v1::JobSpec spec = request->spec();
+    std::optional<CallAuthorization> authorization = call_authorization(context);
+    spec.set_owner(authorization && authorization->principal ? authorization->principal->name
+                                                             : std::string());
+    ClientLimitsState& state = client_limits_state();
+    std::unique_lock lock(state.mutex);
+    const size_t max_queued = state.limits.max_queued_jobs_per_owner;
+    if (max_queued == 0) {
+      lock.unlock();
+      *response = coordinator_.submit(spec);
+      return;
+    }
+    // Counting and submitting under one lock: concurrent submissions of one owner cannot both
+    // slip under the limit.
+    size_t queued = 0;
+    for (const v1::JobStatus& job : coordinator_.list())
+      if (job.owner() == spec.owner() && !is_terminal(job.state())) ++queued;
+    if (queued >= max_queued)
+      throw FarmError(FarmErrorCode::ResourceExhausted,
+                      (spec.owner().empty() ? std::string("anonymous clients")
+                                            : "client \"" + spec.owner() + "\"") +
+                          " already has " + std::to_string(queued) +
+                          " unfinished jobs, the limit per client "
+                          "(--max-queued-jobs-per-client " +
+                          std::to_string(max_queued) + "); wait for one to finish or cancel one");
+    *response = coordinator_.submit(spec);
+  });
 }
 
 grpc::ServerUnaryReactor* JobsService::GetJob(grpc::CallbackServerContext* context,
@@ -177,8 +243,10 @@ grpc::ServerUnaryReactor* JobsService::ListJobs(grpc::CallbackServerContext* con
   });
 }
 
-grpc::ServerWriteReactor<v1::JobStatus>* JobsService::WatchJob(grpc::CallbackServerContext*,
+grpc::ServerWriteReactor<v1::JobStatus>* JobsService::WatchJob(grpc::CallbackServerContext* context,
                                                                const v1::WatchJobRequest* request) {
+  if (std::optional<grpc::Status> refused = refusal(context))
+    return new RefusedWriteReactor<v1::JobStatus>(*refused);
   return new WatchReactor(coordinator_, request->job_id());
 }
 
@@ -189,7 +257,9 @@ grpc::ServerUnaryReactor* JobsService::CancelJob(grpc::CallbackServerContext* co
 }
 
 grpc::ServerWriteReactor<v1::ResultChunk>* JobsService::FetchResult(
-    grpc::CallbackServerContext*, const v1::FetchResultRequest* request) {
+    grpc::CallbackServerContext* context, const v1::FetchResultRequest* request) {
+  if (std::optional<grpc::Status> refused = refusal(context))
+    return new RefusedWriteReactor<v1::ResultChunk>(*refused);
   return new FetchReactor(coordinator_, request->job_id());
 }
 

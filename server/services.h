@@ -7,6 +7,16 @@
 
 namespace penumbra::farm {
 
+// Limits per client (per JobSpec.owner: the authenticated name, or one shared anonymous owner
+// with authentication off). 0: no limit.
+struct ClientLimits {
+  size_t max_queued_jobs_per_owner = 0;  // unfinished (queued or running) jobs
+};
+// Process-wide: CoordinatorServer builds the JobsService from the coordinator alone.
+void set_client_limits(const ClientLimits& limits);
+
+// Both services consult the auth interceptor's decision (server/auth.h) first; JobsService sets
+// JobSpec.owner to the authenticated caller and enforces ClientLimits in SubmitJob.
 class JobsService final : public v1::Jobs::CallbackService {
  public:
   explicit JobsService(Coordinator& coordinator) : coordinator_(coordinator) {}

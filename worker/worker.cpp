@@ -1,7 +1,6 @@
 #include "worker/worker.h"
 
-#include <grpcpp/create_channel.h>
-#include <grpcpp/security/credentials.h>
+#include <grpcpp/client_context.h>
 #include <spdlog/spdlog.h>
 #include <tbb/task_arena.h>
 
@@ -13,6 +12,7 @@
 #include "core/render/local_render.h"
 #include "core/sampling/pattern.h"
 #include "penumbra/version.h"
+#include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
 
 namespace penumbra::farm {
@@ -42,15 +42,15 @@ std::string describe(const grpc::Status& status) {
 RenderWorker::RenderWorker(WorkerOptions options) : options_(std::move(options)) {
   if (options_.threads < 1) options_.threads = 1;
   if (options_.build_flavour.empty()) options_.build_flavour = kBuildFlavour;
-  grpc::ChannelArguments arguments;
-  arguments.SetMaxReceiveMessageSize(1 << 30);
-  arguments.SetMaxSendMessageSize(1 << 30);
-  // Reconnect quickly when the coordinator comes back (the default waits up to two minutes).
-  arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
-  arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
-  arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
-  channel_ = grpc::CreateCustomChannel(options_.coordinator, grpc::InsecureChannelCredentials(),
-                                       arguments);
+  // The farm's channel: large messages, quick reconnection when the coordinator comes back (the
+  // default waits up to two minutes), TLS and the token on every call when configured.
+  FarmConnection connection;
+  connection.address = options_.coordinator;
+  connection.tls_ca = options_.tls_ca;
+  connection.tls_cert = options_.tls_cert;
+  connection.tls_key = options_.tls_key;
+  connection.token = options_.token;
+  channel_ = make_farm_channel(connection);
   stub_ = v1::Workers::NewStub(channel_);
 }
 
@@ -95,7 +95,9 @@ int RenderWorker::run() {
       auto context = context_with_deadline(std::chrono::seconds(10));
       grpc::Status status = stub_->Register(context.get(), request, &response);
       if (status.error_code() == grpc::StatusCode::FAILED_PRECONDITION ||
-          status.error_code() == grpc::StatusCode::INVALID_ARGUMENT) {
+          status.error_code() == grpc::StatusCode::INVALID_ARGUMENT ||
+          status.error_code() == grpc::StatusCode::UNAUTHENTICATED ||
+          status.error_code() == grpc::StatusCode::PERMISSION_DENIED) {
         spdlog::critical("the coordinator refused this worker: {}", status.error_message());
         exit_code = 2;
         break;

@@ -26,6 +26,9 @@ namespace penumbra::farm {
 
 struct WorkerOptions {
   std::string coordinator = "127.0.0.1:7420";
+  // TLS and token (proto/support/farm_client.h FarmConnection; `coordinator` is its address).
+  std::string tls_ca, tls_cert, tls_key;  // PEM paths; tls_ca set: TLS; cert + key: mutual TLS
+  std::string token;                      // "worker" or "admin" role; empty: none
   int threads = 1;
   std::string cache_dir;  // empty: scenes are cached in memory only
   std::string name = "worker";
@@ -37,13 +40,15 @@ struct WorkerOptions {
 
 class RenderWorker {
  public:
+  // Throws std::runtime_error when the connection cannot be set up (unreadable PEM file, a token
+  // over plaintext to a host that is not loopback).
   explicit RenderWorker(WorkerOptions options);
   ~RenderWorker();
   RenderWorker(const RenderWorker&) = delete;
   RenderWorker& operator=(const RenderWorker&) = delete;
 
   // Works until drained (returns 0) or refused by the coordinator (returns 2: wrong build or
-  // protocol; the reason is logged).
+  // protocol, unknown token or a token without the worker role; the reason is logged).
   int run();
   // Stops leasing; run() returns once held tasks are rendered and delivered (or drain_timeout).
   void drain();
