@@ -238,6 +238,25 @@ inline std::unique_ptr<ChildProcess> start_worker(const std::string& address,
       (dir / (name + ".log")).string());
 }
 
+// start_worker with further arguments (TLS, token) after the usual ones.
+inline std::unique_ptr<ChildProcess> start_worker_with(const std::string& address,
+                                                       const std::filesystem::path& dir,
+                                                       const std::string& name,
+                                                       const std::vector<std::string>& extra,
+                                                       int threads = 1) {
+  std::vector<std::string> arguments = {binary("worker/penumbra-worker"),
+                                        "--coordinator",
+                                        address,
+                                        "--threads",
+                                        std::to_string(threads),
+                                        "--cache-dir",
+                                        (dir / ("cache-" + name)).string(),
+                                        "--name",
+                                        name};
+  arguments.insert(arguments.end(), extra.begin(), extra.end());
+  return std::make_unique<ChildProcess>(arguments, (dir / (name + ".log")).string());
+}
+
 inline void expect_bit_identical(FarmClient& client, const std::string& job_id,
                                  const std::string& scene_path, const std::string& method,
                                  uint32_t spp, uint64_t seed) {
