@@ -13,6 +13,8 @@
 #include "core/materials/bsdf.h"
 #include "core/method/smoothing.h"
 #include "core/polygon/ltc_strategy.h"
+#include "core/polygon/ltc_unshadowed_shading.h"
+#include "core/polygon/peters_mis.h"
 #include "core/polygon/psa_strategy.h"
 #include "core/strategies/area_strategy.h"
 #include "core/strategies/bsdf_strategy.h"
@@ -23,10 +25,9 @@ namespace penumbra {
 namespace {
 
 // monostate: not prepared (never sampled or evaluated).
-using PreparedStrategy =
-    std::variant<std::monostate, AreaStrategy, SolidAngleStrategy, BsdfStrategy,
-                 ProjectedSolidAngleStrategy, LtcStrategy, LineAreaStrategy,
-                 LineSolidAngleStrategy>;
+using PreparedStrategy = std::variant<std::monostate, AreaStrategy, SolidAngleStrategy,
+                                      BsdfStrategy, ProjectedSolidAngleStrategy, LtcStrategy,
+                                      LineAreaStrategy, LineSolidAngleStrategy>;
 
 template <typename T>
 constexpr bool is_line_type =
@@ -194,6 +195,52 @@ class PreparedTerms {
   alignas(PreparedStrategy) unsigned char storage_[kMaxMethodTerms][sizeof(PreparedStrategy)];
   size_t count_ = 0;
 };
+
+// Peters 2021 Sec. 4.2-4.3: `psa+ltc/weighted` and `psa+ltc/clamped-optimal`. The weights are per
+// colour channel and need the unshadowed integrals c_j of the shading point and light
+// (core/polygon/peters_mis.h, ltc_unshadowed_shading.h); technique 0 is psa, 1 is ltc.
+bool peters_combination(Combine combine) {
+  return combine == Combine::Weighted || combine == Combine::ClampedOptimal;
+}
+PetersHeuristic peters_heuristic(Combine combine) {
+  return combine == Combine::Weighted ? PetersHeuristic::Weighted : PetersHeuristic::ClampedOptimal;
+}
+int peters_technique(const MethodTerm& term) {
+  return term.strategy == StrategyKind::Ltc ? 1 : 0;
+}
+
+// What Peters' combination needs of one (shading point, light): c_j, the counts n_j (times the
+// multiplier) and which term is which technique.
+struct PetersTerms {
+  UnshadowedIntegrals unshadowed{};
+  TechniqueCounts counts{0, 0};
+  size_t term_of[kPetersTechniques] = {0, 1};
+};
+
+PetersTerms prepare_peters(const MethodSpec& method, const PreparedTerms& prepared,
+                           const ShadingPoint& sp, const Light& light, int multiplier) {
+  PetersTerms peters;
+  const ProjectedSolidAngleStrategy* psa = nullptr;
+  const LtcStrategy* ltc = nullptr;
+  for (size_t k = 0; k < method.terms.size(); ++k) {
+    int j = peters_technique(method.terms[k]);
+    peters.term_of[j] = k;
+    peters.counts[j] = method.terms[k].count * multiplier;
+    if (j == 0) psa = std::get_if<ProjectedSolidAngleStrategy>(&prepared[k]);
+    if (j == 1) ltc = std::get_if<LtcStrategy>(&prepared[k]);
+  }
+  if (psa && ltc) peters.unshadowed = unshadowed_polygon_shading(sp, light, *psa, *ltc);
+  return peters;
+}
+
+// The densities of both techniques at a sample of technique j (its own pdf given).
+TechniqueDensities peters_densities(const PetersTerms& peters, const PreparedTerms& prepared, int j,
+                                    double own_pdf, const Vec3& point) {
+  TechniqueDensities pdfs;
+  for (int k = 0; k < kPetersTechniques; ++k)
+    pdfs[k] = k == j ? own_pdf : pdf_strategy(prepared[peters.term_of[k]], point);
+  return pdfs;
+}
 
 [[noreturn]] void refuse(const MethodSpec& method, const std::string& why) {
   throw FormatError("method", "\"" + to_string(method) + "\": " + why);
@@ -428,9 +475,30 @@ DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
       refuse_non_quads("combination \"" + std::string(combine_name(method.combine)) + "\"",
                        "smooths the BSDF pdf over a quad's (u, v) (Salesin & Jarosz Eq. 23)");
       break;
-    default:
-      refuse(method, "combination \"" + std::string(combine_name(method.combine)) +
-                         "\" is not available yet");
+    case Combine::Weighted:
+    case Combine::ClampedOptimal: {
+      // Peters' heuristics weight a diffuse (psa) and a specular (ltc) technique by their
+      // unshadowed integrals: exactly one term of each.
+      std::string name(combine_name(method.combine));
+      bool one_psa_one_ltc =
+          method.terms.size() == 2 && method.terms[0].strategy != method.terms[1].strategy;
+      for (const MethodTerm& term : method.terms)
+        if (term.strategy != StrategyKind::ProjectedSolidAngle &&
+            term.strategy != StrategyKind::Ltc)
+          one_psa_one_ltc = false;
+      if (!one_psa_one_ltc)
+        refuse(method, "combination \"" + name +
+                           "\" (Peters 2021 Sec. 4.2-4.3) combines one psa term and one ltc term, "
+                           "e.g. \"psa+ltc/" +
+                           name + "\" or \"2*psa+ltc/" + name + "\"");
+      for (size_t l = 0; l < scene.lights.size(); ++l)
+        if (scene.lights[l].type == LightType::Disk)
+          refuse(method, "combination \"" + name +
+                             "\" needs polygon or quad lights (psa and ltc sample polygons); "
+                             "light " +
+                             std::to_string(l) + " is a disk");
+      break;
+    }
   }
 }
 
@@ -450,6 +518,19 @@ std::vector<double> DirectLighting::weights(const ShadingPoint& sp, int light_in
     prepared.emplace_back(prepare(method_.terms[k], sp, light, query));
   LightLines lines = prepare_light_lines(method_, sp, light);
   std::vector<double> out(terms);
+  if (peters_combination(method_.combine)) {
+    // Per-channel weights; reported as their mean over the channels (still summing to one).
+    PetersTerms peters = prepare_peters(method_, prepared, sp, light, multiplier);
+    for (size_t i = 0; i < terms; ++i) {
+      int j = peters_technique(method_.terms[i]);
+      TechniqueDensities pdfs = peters_densities(
+          peters, prepared, j, pdf_strategy(prepared[i], light_point), light_point);
+      Rgb w = peters_mis_weight(peters_heuristic(method_.combine), j, pdfs, peters.unshadowed,
+                                kClampedOptimalBlend, peters.counts);
+      out[i] = (w.x + w.y + w.z) / 3.0;
+    }
+    return out;
+  }
   for (size_t i = 0; i < terms; ++i) {
     // Term i's own pdf at the point, as another term would evaluate it.
     PointLines point_lines;
@@ -491,6 +572,9 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
     for (size_t k = 0; k < term_count; ++k)
       prepared.emplace_back(prepare(method_.terms[k], sp, light, query));
     LightLines lines = prepare_light_lines(method_, sp, light);
+    const bool peters = peters_combination(method_.combine);
+    PetersTerms peters_terms;
+    if (peters) peters_terms = prepare_peters(method_, prepared, sp, light, multiplier);
 
     Rgb light_sum;
     for (size_t i = 0; i < term_count; ++i) {
@@ -525,6 +609,16 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
         // before any line pdf is evaluated (only visible points need one).
         if (!line_term && visibility.occluded(sp.position, sp.normal, x->position)) continue;
 
+        if (peters) {
+          int technique = peters_technique(term);
+          TechniqueSample s{
+              f, peters_densities(peters_terms, prepared, technique, x->pdf_area, x->position)};
+          light_sum += peters_sample_contribution(technique, s, peters_terms.unshadowed,
+                                                  peters_heuristic(method_.combine),
+                                                  kClampedOptimalBlend, peters_terms.counts) /
+                       double(n);
+          continue;
+        }
         double weight = combination_weight(method_, prepared, lines, point_lines, query, i,
                                            x->pdf_area, x->position, multiplier);
         if (weight == 0) continue;

@@ -11,6 +11,12 @@
 //   smooth-fixed, smooth: balance with the BSDF terms' pdfs eased to 0 at the light's edges
 //            (and, for smooth, at occluder edges found by the method's line terms): Salesin &
 //            Jarosz Eq. 22-24, core/method/smoothing.h. Quad lights only.
+//   weighted, clamped-optimal: Peters 2021 Sec. 4.2-4.3 for exactly one psa and one ltc term
+//            (`psa+ltc/weighted`, `2*psa+ltc/clamped-optimal`; polygon and quad lights): per
+//            colour channel w_j = c_j p_j / sum_k c_k p_k with c_j the unshadowed integrals of
+//            the shading point and light (core/polygon/ltc_unshadowed_shading.h), and its blend
+//            with balance (v = 1/2); core/polygon/peters_mis.h. weights() reports the mean of
+//            the three channels' weights.
 //
 // Line terms (`line-area`, `line-sa` with direction u or v; core/lines/line_sampling_*.h) need
 // the Visibility's line query: their own samples are visible by construction (no shadow ray), and

@@ -19,14 +19,8 @@ Rgb combine_samples(int j, std::span<const std::optional<TechniqueSample>> sampl
                     const UnshadowedIntegrals& unshadowed, PetersHeuristic heuristic, double v,
                     const TechniqueCounts& counts) {
   Rgb sum{0, 0, 0};
-  for (const std::optional<TechniqueSample>& s : samples) {
-    if (!s) continue;
-    double own_pdf = s->pdfs[j];
-    if (!(own_pdf > 0) || !std::isfinite(own_pdf) || !is_finite(s->integrand)) continue;
-    Rgb term =
-        peters_mis_weight(heuristic, j, s->pdfs, unshadowed, v, counts) * s->integrand / own_pdf;
-    if (is_finite(term)) sum += term;
-  }
+  for (const std::optional<TechniqueSample>& s : samples)
+    if (s) sum += peters_sample_contribution(j, *s, unshadowed, heuristic, v, counts);
   return samples.empty() ? sum : sum / double(samples.size());
 }
 
@@ -72,6 +66,15 @@ Rgb peters_mis_weight(PetersHeuristic heuristic, int j, const TechniqueDensities
       return clamped_optimal_weight(j, pdfs, unshadowed, v, counts);
   }
   return {0, 0, 0};
+}
+
+Rgb peters_sample_contribution(int j, const TechniqueSample& s,
+                               const UnshadowedIntegrals& unshadowed, PetersHeuristic heuristic,
+                               double v, const TechniqueCounts& counts) {
+  double own_pdf = s.pdfs[j];
+  if (!(own_pdf > 0) || !std::isfinite(own_pdf) || !is_finite(s.integrand)) return {0, 0, 0};
+  Rgb term = peters_mis_weight(heuristic, j, s.pdfs, unshadowed, v, counts) * s.integrand / own_pdf;
+  return is_finite(term) ? term : Rgb{0, 0, 0};
 }
 
 Rgb combine_psa_ltc(const std::array<std::optional<TechniqueSample>, kPetersTechniques>& samples,

@@ -67,6 +67,14 @@ struct TechniqueSample {
   TechniqueDensities pdfs{0, 0};  // p_0(x_j), p_1(x_j), same measure as the integrand's
 };
 
+// One sample's term of F before the 1 / n_j: w_j(x) f(x) / p_j(x) for a sample x of technique j
+// with its densities s.pdfs (the estimator sums these and divides by n_j). 0 where p_j(x) = 0 or
+// anything is not finite. `counts` enter the balance part only (see above).
+Rgb peters_sample_contribution(int j, const TechniqueSample& s,
+                               const UnshadowedIntegrals& unshadowed, PetersHeuristic heuristic,
+                               double v = kClampedOptimalBlend,
+                               const TechniqueCounts& counts = {1, 1});
+
 // F for one sample of psa (index 0) and one of ltc (index 1); an empty sample (the technique drew
 // nothing) contributes 0. Always finite.
 Rgb combine_psa_ltc(const std::array<std::optional<TechniqueSample>, kPetersTechniques>& samples,
