@@ -1,0 +1,88 @@
+#pragma once
+// The `penumbra/batch@1` format (batches/README.md): an equal-time comparison of several methods
+// on one scene, run by the farm's coordinator as a set of jobs (a reference, a calibration pass
+// per method, then one job per method, budget and repeat). This is the reader only: no network,
+// no filesystem. Errors are FormatError (core/scene/scene.h) naming the JSON path, the source and
+// the bad value, like the scene reader's.
+//
+//   {"format": "penumbra/batch@1", "name": "fig1-monoliths", "scene": "monoliths",
+//    "methods": [{"method": "line-sa:v", "sampler": "stratified", "label": "ours"}, "sa"],
+//    "budget": {"seconds": 10, "spp": [16, 64]},
+//    "reference": "auto",  // or "job:job-7", "path/to/ref.exr", {"method":..,"spp":..}
+//    "regions": {"penumbra": [120, 300, 220, 400]}, "seed": 1, "repeats": 3}
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/scene/scene.h"
+
+namespace penumbra {
+
+inline constexpr std::string_view kBatchFormat = "penumbra/batch@1";
+
+// Past these a spec is refused as absurd (the error names the limit).
+struct BatchLimits {
+  size_t max_json_bytes = size_t{1} << 20;
+  int max_json_depth = 16;
+  size_t max_methods = 64;
+  size_t max_spp_levels = 32;   // entries of budget.spp
+  uint32_t max_spp = 1u << 20;  // each spp level and the reference's spp
+  double max_seconds = 1e6;     // budget.seconds (per method and repeat)
+  uint32_t max_repeats = 100;
+  size_t max_regions = 64;
+  size_t max_text_length = 1024;     // names, labels, methods, samplers, paths
+  int64_t max_coordinate = 1 << 16;  // region corners (the scene's resolution is checked later)
+};
+
+struct BatchMethodSpec {
+  std::string method;   // penumbra/method@1 text as written (its grammar is checked)
+  std::string sampler;  // a pattern name (core/sampling/pattern.h); default "stratified"
+  std::string label;    // as written, or the method text; unique within the batch
+};
+
+enum class BatchReferenceKind {
+  Auto,  // rendered by the farm with a robust method at high spp, cached by scene and settings
+  Exr,   // an EXR file the client uploads
+  Job,   // the result of a finished job on the same coordinator
+};
+
+struct BatchReferenceSpec {
+  BatchReferenceKind kind = BatchReferenceKind::Auto;
+  std::string exr_path;  // Exr: as written (relative paths are relative to the spec's folder)
+  std::string job_id;    // Job: "job-7"
+  // Auto: what renders the reference.
+  std::string method = "bsdf+sa";
+  std::string sampler = "stratified";
+  uint32_t spp = 1024;
+  uint64_t seed = 0x5eed;
+};
+
+struct BatchSpec {
+  std::string name;   // "name", else the source's file stem
+  std::string scene;  // a bundled scene name or a path (the client packs it)
+  std::vector<BatchMethodSpec> methods;
+  std::optional<double> budget_seconds;  // compute seconds per method and repeat
+  std::vector<uint32_t> budget_spp;      // spp levels (ascending, distinct)
+  BatchReferenceSpec reference;
+  std::map<std::string, Region> regions;  // merged with the scene's ("image" is reserved)
+  uint64_t seed = 1;                      // repeat r renders with seed + r
+  uint32_t repeats = 1;
+  // Unknown keys the reader ignored (forward compatibility), each as "JSON path: note".
+  std::vector<std::string> warnings;
+};
+
+// Parses and validates a batch spec. `source_name` names the document in messages. Throws
+// FormatError (and nothing else) on any bad input.
+BatchSpec parse_batch_spec(std::string_view json, std::string_view source_name,
+                           const BatchLimits& limits = {});
+
+// A label made safe as a file name: [A-Za-z0-9._-] kept, anything else becomes '_'
+// ("line-sa:v" -> "line-sa_v"); never empty, never "." or "..".
+std::string file_safe_label(std::string_view label);
+
+}  // namespace penumbra
