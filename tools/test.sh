@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Builds Penumbra and runs every test: the Release build (all tests, farm included), then the
-# core tests again under AddressSanitizer + UndefinedBehaviorSanitizer. Ends with one line
+# core tests again under AddressSanitizer + UndefinedBehaviorSanitizer (clang, with the libFuzzer
+# targets of fuzz/ built in the same tree), then each fuzz target for a bounded time under
+# ASan + UBSan + LeakSanitizer, two at a time, each counted as one test. Ends with one line
 # "N passed, N failed". Installs what it needs first (Debian 12, as root).
-#   PENUMBRA_SKIP_SANITIZE=1  skip the sanitizer pass (quick local runs)
+#   PENUMBRA_SKIP_SANITIZE=1  skip the sanitizer pass and the fuzzing (quick local runs)
+#   PENUMBRA_FUZZ_SECONDS=N   seconds per fuzz target (default 60; 0 skips the fuzzing)
 #   PENUMBRA_JOBS=N           build jobs (default: cores)
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +25,7 @@ run_suite() {  # name build-dir ctest-exclude-regex cmake-args...
   if ! ninja -C "$dir" -j "$jobs" >"$dir.build.log" 2>&1; then
     tail -n 60 "$dir.build.log"; echo "$name: build failed"; failed=$((failed + 1)); status=1; return
   fi
+  [ "$name" = "asan+ubsan" ] && sanitize_built=1
   echo "== $name: ctest"
   local log="$dir.ctest.log"
   local filter=()
@@ -36,16 +40,68 @@ run_suite() {  # name build-dir ctest-exclude-regex cmake-args...
   [ "$fails" = 0 ] || status=1
 }
 
+# Each libFuzzer target of fuzz/ for `seconds`, two at a time (2 cores), new inputs going to a
+# scratch corpus (the committed seeds in fuzz/corpus/<target>/ are only read). A target passes
+# when it finishes without a crash, leak, timeout or sanitizer report; a failing input is kept as
+# <dir>/fuzz-artifacts/<target>-crash-... (reproduce: <dir>/fuzz/fuzz_<target> <that file>).
+run_fuzzers() {  # build-dir seconds
+  local dir=$1 seconds=$2
+  [ "$seconds" -gt 0 ] 2>/dev/null || { echo "== fuzzing skipped (PENUMBRA_FUZZ_SECONDS=$seconds)"; return; }
+  # The targets the build configured (fuzz_batch_spec only once core/batch/ exists).
+  local targets=() target
+  for target in "$dir"/fuzz/fuzz_*; do
+    [ -x "$target" ] && [ -f "$target" ] && targets+=("${target##*/fuzz_}")
+  done
+  if [ "${#targets[@]}" = 0 ]; then
+    echo "fuzzing: no fuzz_* programs in $dir/fuzz"; failed=$((failed + 1)); status=1; return
+  fi
+  echo "== fuzzing: ${#targets[@]} targets, ${seconds} s each, 2 at a time"
+  rm -rf "$dir/fuzz-work" "$dir/fuzz-artifacts"
+  mkdir -p "$dir/fuzz-work" "$dir/fuzz-artifacts"
+  local running=0
+  for target in "${targets[@]}"; do
+    (
+      local binary="$dir/fuzz/fuzz_$target" log="$dir/fuzz-work/$target.log"
+      local options=(-max_total_time="$seconds" -timeout=30 -rss_limit_mb=2048 -print_final_stats=1
+                     -artifact_prefix="$dir/fuzz-artifacts/$target-")
+      [ -f "fuzz/dictionaries/$target.dict" ] && options+=(-dict="fuzz/dictionaries/$target.dict")
+      mkdir -p "$dir/fuzz-work/$target"
+      "$binary" "${options[@]}" "$dir/fuzz-work/$target" "fuzz/corpus/$target" >"$log" 2>&1
+      echo $? >"$dir/fuzz-work/$target.rc"
+    ) &
+    running=$((running + 1))
+    if [ "$running" -ge 2 ]; then wait -n; running=$((running - 1)); fi
+  done
+  wait
+  for target in "${targets[@]}"; do
+    local rc log="$dir/fuzz-work/$target.log"
+    rc=$(cat "$dir/fuzz-work/$target.rc" 2>/dev/null || echo 1)
+    if [ "$rc" = 0 ]; then
+      passed=$((passed + 1))
+      echo "fuzz_$target: passed ($(grep -m1 -o 'stat::number_of_executed_units: [0-9]*' "$log" | sed 's/.*: //') runs, $(grep -o 'cov: [0-9]*' "$log" | tail -n 1))"
+    else
+      failed=$((failed + 1)); status=1
+      echo "fuzz_$target: FAILED (exit $rc); the end of its log ($log):"
+      tail -n 40 "$log"
+    fi
+  done
+}
+
 mkdir -p build
+sanitize_built=0
 run_suite "release" build/release "" -DCMAKE_BUILD_TYPE=Release -DPENUMBRA_FARM=ON -DPENUMBRA_BENCH=ON
 if [ "${PENUMBRA_SKIP_SANITIZE:-0}" != 1 ]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   # The paper reproductions are statistical end-to-end runs of code the unit tests cover; under
   # the sanitizers they would take most of the budget, so they run in the release pass only.
-  run_suite "asan+ubsan" build/sanitize "^(ReproductionSuite|LinesSalesinJarosz|LinesBillenDutre)\\." \
+  # clang, so that libFuzzer's targets build in the same tree (a fresh folder: CMake keeps the
+  # compiler of a folder's first configure).
+  CC=clang CXX=clang++ \
+  run_suite "asan+ubsan" build/sanitize-clang "^(ReproductionSuite|LinesSalesinJarosz|LinesBillenDutre)\\." \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPENUMBRA_SANITIZE=ON \
-    -DPENUMBRA_FARM=OFF -DPENUMBRA_BENCH=OFF
+    -DPENUMBRA_FARM=OFF -DPENUMBRA_BENCH=OFF -DPENUMBRA_FUZZ=ON
+  [ "$sanitize_built" = 1 ] && run_fuzzers build/sanitize-clang "${PENUMBRA_FUZZ_SECONDS:-60}"
 fi
 echo "$passed passed, $failed failed"
 exit $status

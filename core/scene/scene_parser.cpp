@@ -19,6 +19,10 @@ namespace penumbra {
 namespace {
 
 constexpr std::string_view kSceneFormat = "penumbra/scene@1";
+// Past this a radiance component is refused as absurd: 1e15 leaves room for tiny bright lights
+// (the renderer tests use 1e9 on a 1 mm light at 40 m; bundled scenes stay below 1e4) and keeps
+// every estimator's products far from overflowing a double.
+constexpr double kMaxRadiance = 1e15;
 
 std::string number_text(double x) {
   std::ostringstream out;
@@ -125,6 +129,10 @@ class SceneParser {
     Rgb c = node.vec3();
     for (int i = 0; i < 3; ++i)
       if (c[i] < 0) node.fail("negative radiance " + node.quoted_value());
+    for (int i = 0; i < 3; ++i)
+      if (c[i] > kMaxRadiance)
+        node.fail("radiance " + node.quoted_value() +
+                  " exceeds the limit max_radiance = " + number_text(kMaxRadiance));
     return c;
   }
 

@@ -3,6 +3,7 @@
 #include <tiny_obj_loader.h>
 
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -83,7 +84,56 @@ TriangleMesh icosphere_mesh(const Vec3& center, double radius, int subdivisions)
   return mesh;
 }
 
+namespace {
+
+// tinyobjloader reads a vertex coordinate it cannot parse ("nan", "1e999", "x") as 0 and a
+// missing one as 0 too, which silently moves the vertex. Every `v` line must therefore hold at
+// least 3 numbers, each a finite double (a trailing `# comment` is allowed).
+void check_obj_vertex_lines(std::string_view text) {
+  size_t line_number = 0;
+  while (!text.empty()) {
+    ++line_number;
+    size_t end = text.find('\n');
+    std::string_view line = text.substr(0, end);
+    text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
+    auto is_blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    size_t start = 0;
+    while (start < line.size() && is_blank(line[start])) ++start;
+    if (line.size() < start + 2 || line[start] != 'v' || !is_blank(line[start + 1])) continue;
+    // The fields after "v", up to a comment.
+    line = line.substr(start + 1);
+    line = line.substr(0, line.find('#'));
+    int numbers = 0;
+    size_t position = 0;
+    while (true) {
+      while (position < line.size() && is_blank(line[position])) ++position;
+      if (position == line.size()) break;
+      size_t token_end = position;
+      while (token_end < line.size() && !is_blank(line[token_end])) ++token_end;
+      std::string_view token = line.substr(position, token_end - position);
+      std::string_view digits = token.front() == '+' ? token.substr(1) : token;
+      double value = 0;
+      auto [parsed_end, error] =
+          std::from_chars(digits.data(), digits.data() + digits.size(), value);
+      if (error != std::errc() || parsed_end != digits.data() + digits.size() ||
+          !std::isfinite(value))
+        throw std::invalid_argument("OBJ line " + std::to_string(line_number) +
+                                    ": vertex coordinate '" + std::string(token.substr(0, 32)) +
+                                    "' is not a finite number");
+      ++numbers;
+      position = token_end;
+    }
+    if (numbers < 3)
+      throw std::invalid_argument("OBJ line " + std::to_string(line_number) +
+                                  ": a vertex needs 3 " + "coordinates, got " +
+                                  std::to_string(numbers));
+  }
+}
+
+}  // namespace
+
 TriangleMesh obj_mesh(const std::string& obj_bytes, const Vec3& scale, const Vec3& translate) {
+  check_obj_vertex_lines(obj_bytes);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
