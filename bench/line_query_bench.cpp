@@ -12,6 +12,11 @@
 // machines drift by ~25% hour to hour; ratios in one run do not).
 //
 // Run: build-*/bench/line_query_bench [--benchmark_filter=S1] [--benchmark_repetitions=5]
+//      [--queries=N]   (a fixed number of iterations per benchmark: repeatable instruction
+//                       counts under callgrind, e.g.
+//   valgrind --tool=callgrind --toggle-collect='penumbra::LineQuery::visible_intervals*'
+//     build-*/bench/line_query_bench --benchmark_filter=line_query_medium/S1 --queries=12000
+//   and divide the instructions by the iterations plus the brute-force checks, 256 on S1)
 
 #include <benchmark/benchmark.h>
 #include <embree3/rtcore.h>
@@ -349,23 +354,36 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 int main(int argc, char** argv) {
   using namespace penumbra;
+  // --queries=N: fixed iterations (removed before Google Benchmark parses the rest).
+  long fixed_iterations = 0;
+  for (int i = 1; i < argc; ++i) {
+    std::string argument(argv[i]);
+    if (argument.rfind("--queries=", 0) != 0) continue;
+    fixed_iterations = std::stol(argument.substr(10));
+    for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
+    --argc;
+    --i;
+  }
+  auto fix = [&](benchmark::internal::Benchmark* benchmark) {
+    benchmark->Unit(benchmark::kNanosecond);
+    if (fixed_iterations > 0) benchmark->Iterations(fixed_iterations);
+  };
   // Flush-to-zero and denormals-are-zero, as every render thread sets them.
   _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
   _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
   for (const char* scene : {"S1", "S3", "S2"}) {
     std::string name(scene);
-    benchmark::RegisterBenchmark((std::string("shadow_ray/") + name).c_str(),
-                                 [name](benchmark::State& state) { shadow_rays(state, name); })
-        ->Unit(benchmark::kNanosecond);
-    benchmark::RegisterBenchmark((std::string("line_query_medium/") + name).c_str(),
-                                 [name](benchmark::State& state) {
-                                   line_queries(state, name, LineQueryBuildQuality::Medium);
-                                 })
-        ->Unit(benchmark::kNanosecond);
-    benchmark::RegisterBenchmark(
-        (std::string("line_query_high/") + name).c_str(),
-        [name](benchmark::State& state) { line_queries(state, name, LineQueryBuildQuality::High); })
-        ->Unit(benchmark::kNanosecond);
+    fix(benchmark::RegisterBenchmark(
+        (std::string("shadow_ray/") + name).c_str(),
+        [name](benchmark::State& state) { shadow_rays(state, name); }));
+    fix(benchmark::RegisterBenchmark((std::string("line_query_medium/") + name).c_str(),
+                                     [name](benchmark::State& state) {
+                                       line_queries(state, name, LineQueryBuildQuality::Medium);
+                                     }));
+    fix(benchmark::RegisterBenchmark((std::string("line_query_high/") + name).c_str(),
+                                     [name](benchmark::State& state) {
+                                       line_queries(state, name, LineQueryBuildQuality::High);
+                                     }));
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

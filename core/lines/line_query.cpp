@@ -1,7 +1,7 @@
 #include "core/lines/line_query.h"
 
 #include <embree3/rtcore.h>
-#include <xmmintrin.h>
+#include <immintrin.h>
 
 #include <atomic>
 #include <cfloat>
@@ -28,8 +28,8 @@ struct BuildNode {
 struct BuildInner {
   BuildNode base{false};
   unsigned child_count = 0;
-  BuildNode* children[4] = {};
-  RTCBounds bounds[4] = {};
+  BuildNode* children[LineQuery::kWidth] = {};
+  RTCBounds bounds[LineQuery::kWidth] = {};
 };
 
 struct BuildLeaf {
@@ -101,43 +101,241 @@ Vec3 absolute(const Vec3& v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Traversal: a linear function f(p) = dot(gradient, p) + offset over four boxes at once, as
-// its value at the centres (`middle`) and a radius: [middle - radius, middle + radius] contains
-// the exact range of f over each box.
+// Traversal. The node test needs, per query, a few linear functions f(p) = dot(gradient, p) +
+// offset over boxes: their value at a box's centre (`middle`) and a radius, so that
+// [middle - radius, middle + radius] contains the exact range of f over the box. The constants
+// are floats stored four times over (Lanes4): the SSE test loads them as they are, the AVX test
+// broadcasts the first.
 
-struct LinearRange4 {
-  __m128 gradient[3], gradient_magnitude[3];
-  __m128 offset, error;
+struct alignas(16) Lanes4 {
+  float v[4];
+  void set(double value) { _mm_store_ps(v, _mm_set1_ps(static_cast<float>(value))); }
+  __m128 sse() const { return _mm_load_ps(v); }
+};
+
+struct LinearFunction {
+  Lanes4 gradient[3], magnitude[3], offset, error;
 
   // `coordinate_bound` is max |p| over the scene plus |x|, per axis (computed once per query).
-  LinearRange4(const Vec3& gradient_d, const Vec3& x, const Vec3& coordinate_bound) {
-    double offset_d = -dot(gradient_d, x);
+  void set(const Vec3& gradient_d, const Vec3& x, const Vec3& coordinate_bound) {
     // Float error of evaluating dot(g, c) + offset and dot(|g|, e) with g, offset, c, e rounded
     // to float: a few ulps of the largest partial sum, bounded by |g|.(max |p| + |x|) since
     // centres and extents are bounded by the scene's extent; 32 ulps to be safe.
-    Vec3 magnitude = absolute(gradient_d);
-    double error_d = 32 * (FLT_EPSILON / 2) * dot(magnitude, coordinate_bound);
+    error.set(32 * (FLT_EPSILON / 2) * dot(absolute(gradient_d), coordinate_bound));
+    offset.set(-dot(gradient_d, x));
+    // |float(g)| == float(|g|) (rounding is symmetric): the magnitudes are the gradients with
+    // the sign bit cleared.
+    const __m128 sign_bit = _mm_set1_ps(-0.0f);
     for (int k = 0; k < 3; ++k) {
-      gradient[k] = _mm_set1_ps(static_cast<float>(gradient_d[k]));
-      gradient_magnitude[k] = _mm_set1_ps(static_cast<float>(magnitude[k]));
+      gradient[k].set(gradient_d[k]);
+      _mm_store_ps(magnitude[k].v, _mm_andnot_ps(sign_bit, gradient[k].sse()));
     }
-    offset = _mm_set1_ps(static_cast<float>(offset_d));
-    error = _mm_set1_ps(static_cast<float>(error_d));
-  }
-
-  void evaluate(const __m128 center[3], const __m128 extent[3], __m128& middle,
-                __m128& radius) const {
-    middle = _mm_add_ps(
-        _mm_add_ps(offset, _mm_mul_ps(gradient[0], center[0])),
-        _mm_add_ps(_mm_mul_ps(gradient[1], center[1]), _mm_mul_ps(gradient[2], center[2])));
-    radius = radius_of(extent);
-  }
-  __m128 radius_of(const __m128 extent[3]) const {
-    return _mm_add_ps(_mm_add_ps(error, _mm_mul_ps(gradient_magnitude[0], extent[0])),
-                      _mm_add_ps(_mm_mul_ps(gradient_magnitude[1], extent[1]),
-                                 _mm_mul_ps(gradient_magnitude[2], extent[2])));
   }
 };
+
+// Everything the node test needs from one query.
+struct NodeTestSetup {
+  Lanes4 region_lower[3], region_upper[3];  // bounding box of the crossing region
+  LinearFunction distance, alpha, beta;     // see shadow_triangle.h
+  Lanes4 depth_magnitude[3], depth_error;   // depth s = alpha + beta: radius only
+  Lanes4 s_min, s_max;
+};
+
+// What the node test returns for each surviving child: the t-range its box projects to on the
+// segment and the lower bound of its depth s (the near-to-far order).
+struct ChildRanges {
+  alignas(32) float t_lower[LineQuery::kWidth];
+  alignas(32) float t_upper[LineQuery::kWidth];
+  alignas(32) float depth_lower[LineQuery::kWidth];
+};
+
+// The node test, the same float operations in the same order per lane in both versions (no
+// fused multiply-add: the build has -ffp-contract=off and the AVX version does not enable
+// FMA), so they keep the same children. Ordered comparisons: NaN centres (empty slots) fail.
+//
+// Cheapest tests first: the child box against the crossing region's bounding box (the
+// triangle-box test's box-axis half, Akenine-Möller 2001) and against the shadow plane
+// (|distance| <= radius). Most rejected children fail one of these, and then alpha, beta and
+// depth are never computed. Then the side planes through x (alpha >= 0, beta >= 0), the plane
+// through the segment (s < s_max) and the self-occlusion plane (s > s_min). Finally the
+// surviving boxes are projected from x onto the segment: within the wedge (alpha, beta >= 0),
+// t = beta / (alpha + beta) grows with beta and falls with alpha, so over the box's [alpha] x
+// [beta] rectangle its range is [beta_lo / (alpha_hi + beta_lo), beta_hi / (alpha_lo + beta_hi)]
+// with negative bounds clamped to 0. Returns the bit mask of the surviving children.
+using NodeTest = unsigned (*)(const LineQuery::Node& node, const NodeTestSetup& setup,
+                              ChildRanges& out);
+
+unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& setup,
+                           ChildRanges& out) {
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 tiny = _mm_set1_ps(FLT_MIN);
+  const __m128 sign_bit = _mm_set1_ps(-0.0f);
+  auto middle_of = [](const LinearFunction& f, const __m128 center[3]) {
+    return _mm_add_ps(_mm_add_ps(f.offset.sse(), _mm_mul_ps(f.gradient[0].sse(), center[0])),
+                      _mm_add_ps(_mm_mul_ps(f.gradient[1].sse(), center[1]),
+                                 _mm_mul_ps(f.gradient[2].sse(), center[2])));
+  };
+  auto radius_of = [](const Lanes4& error, const Lanes4 magnitude[3], const __m128 extent[3]) {
+    return _mm_add_ps(_mm_add_ps(error.sse(), _mm_mul_ps(magnitude[0].sse(), extent[0])),
+                      _mm_add_ps(_mm_mul_ps(magnitude[1].sse(), extent[1]),
+                                 _mm_mul_ps(magnitude[2].sse(), extent[2])));
+  };
+  unsigned result = 0;
+  for (int half = 0; half < LineQuery::kWidth; half += 4) {
+    const __m128 center[3] = {_mm_load_ps(node.center[0] + half),
+                              _mm_load_ps(node.center[1] + half),
+                              _mm_load_ps(node.center[2] + half)};
+    const __m128 extent[3] = {_mm_load_ps(node.extent[0] + half),
+                              _mm_load_ps(node.extent[1] + half),
+                              _mm_load_ps(node.extent[2] + half)};
+    __m128 keep = _mm_cmple_ps(_mm_sub_ps(center[0], extent[0]), setup.region_upper[0].sse());
+    keep = _mm_and_ps(keep,
+                      _mm_cmpge_ps(_mm_add_ps(center[0], extent[0]), setup.region_lower[0].sse()));
+    for (int k = 1; k < 3; ++k) {
+      keep = _mm_and_ps(
+          keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), setup.region_upper[k].sse()));
+      keep = _mm_and_ps(
+          keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), setup.region_lower[k].sse()));
+    }
+    if (_mm_movemask_ps(keep) == 0) continue;
+    const __m128 distance_middle = middle_of(setup.distance, center);
+    const __m128 distance_radius =
+        radius_of(setup.distance.error, setup.distance.magnitude, extent);
+    keep =
+        _mm_and_ps(keep, _mm_cmple_ps(_mm_andnot_ps(sign_bit, distance_middle), distance_radius));
+    if (_mm_movemask_ps(keep) == 0) continue;
+
+    const __m128 alpha_middle = middle_of(setup.alpha, center);
+    const __m128 alpha_radius = radius_of(setup.alpha.error, setup.alpha.magnitude, extent);
+    const __m128 beta_middle = middle_of(setup.beta, center);
+    const __m128 beta_radius = radius_of(setup.beta.error, setup.beta.magnitude, extent);
+    const __m128 depth_middle = _mm_add_ps(alpha_middle, beta_middle);
+    const __m128 depth_radius = radius_of(setup.depth_error, setup.depth_magnitude, extent);
+    const __m128 alpha_lower = _mm_sub_ps(alpha_middle, alpha_radius);
+    const __m128 alpha_upper = _mm_add_ps(alpha_middle, alpha_radius);
+    const __m128 beta_lower = _mm_sub_ps(beta_middle, beta_radius);
+    const __m128 beta_upper = _mm_add_ps(beta_middle, beta_radius);
+    const __m128 depth_lower = _mm_sub_ps(depth_middle, depth_radius);
+    const __m128 depth_upper = _mm_add_ps(depth_middle, depth_radius);
+    keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
+    keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
+    keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, setup.s_min.sse()));
+    keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, setup.s_max.sse()));
+    const unsigned mask = static_cast<unsigned>(_mm_movemask_ps(keep));
+    if (mask == 0) continue;
+
+    const __m128 beta_lower_clamped = _mm_max_ps(beta_lower, zero);
+    const __m128 alpha_lower_clamped = _mm_max_ps(alpha_lower, zero);
+    _mm_store_ps(out.t_lower + half,
+                 _mm_div_ps(beta_lower_clamped,
+                            _mm_max_ps(_mm_add_ps(alpha_upper, beta_lower_clamped), tiny)));
+    _mm_store_ps(
+        out.t_upper + half,
+        _mm_div_ps(beta_upper, _mm_max_ps(_mm_add_ps(alpha_lower_clamped, beta_upper), tiny)));
+    _mm_store_ps(out.depth_lower + half, depth_lower);
+    result |= mask << half;
+  }
+  return result;
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+#define PENUMBRA_LINE_QUERY_AVX 1
+#define PENUMBRA_AVX __attribute__((target("avx"), always_inline)) inline
+
+// AVX helpers of the node test (lambdas would not inherit the target attribute).
+PENUMBRA_AVX __m256 lanes(const Lanes4& value) {
+  return _mm256_broadcast_ss(value.v);
+}
+PENUMBRA_AVX __m256 middle_of(const LinearFunction& f, const __m256 center[3]) {
+  return _mm256_add_ps(
+      _mm256_add_ps(lanes(f.offset), _mm256_mul_ps(lanes(f.gradient[0]), center[0])),
+      _mm256_add_ps(_mm256_mul_ps(lanes(f.gradient[1]), center[1]),
+                    _mm256_mul_ps(lanes(f.gradient[2]), center[2])));
+}
+PENUMBRA_AVX __m256 radius_of(const Lanes4& error, const Lanes4 magnitude[3],
+                              const __m256 extent[3]) {
+  return _mm256_add_ps(_mm256_add_ps(lanes(error), _mm256_mul_ps(lanes(magnitude[0]), extent[0])),
+                       _mm256_add_ps(_mm256_mul_ps(lanes(magnitude[1]), extent[1]),
+                                     _mm256_mul_ps(lanes(magnitude[2]), extent[2])));
+}
+
+// The same test on all eight children at once (AVX, 256-bit; selected at run time).
+__attribute__((target("avx"))) unsigned test_children_avx(const LineQuery::Node& node,
+                                                          const NodeTestSetup& setup,
+                                                          ChildRanges& out) {
+  static_assert(LineQuery::kWidth == 8, "the AVX node test handles eight children");
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 tiny = _mm256_set1_ps(FLT_MIN);
+  const __m256 sign_bit = _mm256_set1_ps(-0.0f);
+  const __m256 center[3] = {_mm256_load_ps(node.center[0]), _mm256_load_ps(node.center[1]),
+                            _mm256_load_ps(node.center[2])};
+  const __m256 extent[3] = {_mm256_load_ps(node.extent[0]), _mm256_load_ps(node.extent[1]),
+                            _mm256_load_ps(node.extent[2])};
+  __m256 keep =
+      _mm256_cmp_ps(_mm256_sub_ps(center[0], extent[0]), lanes(setup.region_upper[0]), _CMP_LE_OQ);
+  keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_add_ps(center[0], extent[0]),
+                                           lanes(setup.region_lower[0]), _CMP_GE_OQ));
+  for (int k = 1; k < 3; ++k) {
+    keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_sub_ps(center[k], extent[k]),
+                                             lanes(setup.region_upper[k]), _CMP_LE_OQ));
+    keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_add_ps(center[k], extent[k]),
+                                             lanes(setup.region_lower[k]), _CMP_GE_OQ));
+  }
+  if (_mm256_movemask_ps(keep) == 0) return 0;
+  const __m256 distance_middle = middle_of(setup.distance, center);
+  const __m256 distance_radius = radius_of(setup.distance.error, setup.distance.magnitude, extent);
+  keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_andnot_ps(sign_bit, distance_middle),
+                                           distance_radius, _CMP_LE_OQ));
+  if (_mm256_movemask_ps(keep) == 0) return 0;
+
+  const __m256 alpha_middle = middle_of(setup.alpha, center);
+  const __m256 alpha_radius = radius_of(setup.alpha.error, setup.alpha.magnitude, extent);
+  const __m256 beta_middle = middle_of(setup.beta, center);
+  const __m256 beta_radius = radius_of(setup.beta.error, setup.beta.magnitude, extent);
+  const __m256 depth_middle = _mm256_add_ps(alpha_middle, beta_middle);
+  const __m256 depth_radius = radius_of(setup.depth_error, setup.depth_magnitude, extent);
+  const __m256 alpha_lower = _mm256_sub_ps(alpha_middle, alpha_radius);
+  const __m256 alpha_upper = _mm256_add_ps(alpha_middle, alpha_radius);
+  const __m256 beta_lower = _mm256_sub_ps(beta_middle, beta_radius);
+  const __m256 beta_upper = _mm256_add_ps(beta_middle, beta_radius);
+  const __m256 depth_lower = _mm256_sub_ps(depth_middle, depth_radius);
+  const __m256 depth_upper = _mm256_add_ps(depth_middle, depth_radius);
+  keep = _mm256_and_ps(keep, _mm256_cmp_ps(alpha_upper, zero, _CMP_GE_OQ));
+  keep = _mm256_and_ps(keep, _mm256_cmp_ps(beta_upper, zero, _CMP_GE_OQ));
+  keep = _mm256_and_ps(keep, _mm256_cmp_ps(depth_upper, lanes(setup.s_min), _CMP_GT_OQ));
+  keep = _mm256_and_ps(keep, _mm256_cmp_ps(depth_lower, lanes(setup.s_max), _CMP_LT_OQ));
+  const unsigned mask = static_cast<unsigned>(_mm256_movemask_ps(keep));
+  if (mask == 0) return 0;
+
+  const __m256 beta_lower_clamped = _mm256_max_ps(beta_lower, zero);
+  const __m256 alpha_lower_clamped = _mm256_max_ps(alpha_lower, zero);
+  _mm256_store_ps(
+      out.t_lower,
+      _mm256_div_ps(beta_lower_clamped,
+                    _mm256_max_ps(_mm256_add_ps(alpha_upper, beta_lower_clamped), tiny)));
+  _mm256_store_ps(
+      out.t_upper,
+      _mm256_div_ps(beta_upper,
+                    _mm256_max_ps(_mm256_add_ps(alpha_lower_clamped, beta_upper), tiny)));
+  _mm256_store_ps(out.depth_lower, depth_lower);
+  return mask;
+}
+#endif
+
+#ifdef PENUMBRA_LINE_QUERY_AVX
+constexpr NodeTest node_test_avx = test_children_avx;
+#else
+constexpr NodeTest node_test_avx = test_children_sse;
+#endif
+
+bool cpu_has_avx() {
+#ifdef PENUMBRA_LINE_QUERY_AVX
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx");
+#else
+  return false;
+#endif
+}
 
 // Stack entry: a node or leaf code with the t-range its box projects to (re-checked when popped,
 // since cuts found in the meantime may have covered it).
@@ -148,7 +346,7 @@ struct StackEntry {
 
 // Slack on projected t-ranges (t is in [0,1]): float rounding of one add and one divide.
 constexpr float kProjectionSlack = 1e-6f;
-constexpr int kStackCapacity = 256;  // 3 entries per level: depth checked at build
+constexpr int kStackCapacity = 256;  // kWidth - 1 entries per level: depth checked at build
 
 }  // namespace
 
@@ -225,7 +423,7 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   RTCBuildArguments arguments = rtcDefaultBuildArguments();
   arguments.byteSize = sizeof(arguments);
   arguments.buildQuality = embree_quality(options_.build_quality);
-  arguments.maxBranchingFactor = 4;
+  arguments.maxBranchingFactor = kWidth;
   arguments.maxDepth = 32;
   arguments.sahBlockSize = 1;
   arguments.minLeafSize = 1;
@@ -259,7 +457,7 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   auto new_node = [&]() {
     Node node;
     for (int k = 0; k < 3; ++k) {
-      for (int slot = 0; slot < 4; ++slot) {
+      for (int slot = 0; slot < kWidth; ++slot) {
         node.center[k][slot] = nan;
         node.extent[k][slot] = 0;
       }
@@ -288,9 +486,9 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     }
     node.child[slot] = code;
   };
-  // Returns the code of the flattened subtree. The traversal stack holds at most 3 entries per
-  // level plus 4, so the depth is bounded (Embree's maxDepth is 32; checked anyway).
-  const int max_depth = (kStackCapacity - 4) / 3;
+  // Returns the code of the flattened subtree. The traversal stack holds at most kWidth - 1
+  // entries per level plus kWidth, so the depth is bounded (Embree's maxDepth is 32; checked).
+  const int max_depth = (kStackCapacity - kWidth) / (kWidth - 1);
   auto flatten = [&](auto&& self, const BuildNode* node, int depth) -> uint32_t {
     if (node->is_leaf) return flatten_leaf(reinterpret_cast<const BuildLeaf*>(node));
     if (depth > max_depth)
@@ -328,6 +526,10 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   }
   rtcReleaseBVH(bvh);
   rtcReleaseDevice(device);
+  use_avx_ = options_.allow_avx && cpu_has_avx();
+  // Prefetch only when the structure is larger than a typical L2 cache.
+  prefetch_ = nodes_.size() * sizeof(Node) + triangles_.size() * sizeof(OccluderTriangle) >
+              (size_t{1} << 20);
   if (status.oversized_leaf)
     throw std::runtime_error("LineQuery: Embree made a leaf larger than " +
                              std::to_string(RTC_BUILD_MAX_PRIMITIVES_PER_LEAF) + " triangles");
@@ -352,54 +554,61 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
   // One bound for all four error terms (|g|.(max |p| + |x|); double rounding of the sum is far
   // below the 32-ulp float margin).
   const Vec3 coordinate_bound = scene_max_abs_ + absolute(x);
-  const LinearRange4 distance_range(normalize(shadow->plane_normal), x, coordinate_bound);
-  const LinearRange4 alpha_range(shadow->alpha_gradient, x, coordinate_bound);
-  const LinearRange4 beta_range(shadow->beta_gradient, x, coordinate_bound);
-  // Depth s = alpha + beta: its middle is the sum of theirs, so its error bound is the sum of
-  // theirs too (plus its own, for the radius).
-  LinearRange4 depth_range(shadow->alpha_gradient + shadow->beta_gradient, x, coordinate_bound);
-  depth_range.error =
-      _mm_add_ps(depth_range.error, _mm_add_ps(alpha_range.error, beta_range.error));
-  const __m128 zero = _mm_setzero_ps();
-  const __m128 tiny = _mm_set1_ps(FLT_MIN);
-  const __m128 sign_bit = _mm_set1_ps(-0.0f);
-  const __m128 s_min = _mm_set1_ps(static_cast<float>(shadow->s_min));
-  const __m128 s_max = _mm_set1_ps(static_cast<float>(shadow->s_max));
+  NodeTestSetup setup;
+  setup.distance.set(normalize(shadow->plane_normal), x, coordinate_bound);
+  setup.alpha.set(shadow->alpha_gradient, x, coordinate_bound);
+  setup.beta.set(shadow->beta_gradient, x, coordinate_bound);
+  {
+    // Depth s = alpha + beta: its middle is the sum of theirs, so its error bound is the sum of
+    // theirs too (plus its own, for the radius).
+    const Vec3 depth_gradient = shadow->alpha_gradient + shadow->beta_gradient;
+    const double depth_error =
+        32 * (FLT_EPSILON / 2) * dot(absolute(depth_gradient), coordinate_bound);
+    const __m128 sign_bit = _mm_set1_ps(-0.0f);
+    for (int k = 0; k < 3; ++k) {
+      setup.depth_magnitude[k].set(depth_gradient[k]);
+      _mm_store_ps(setup.depth_magnitude[k].v,
+                   _mm_andnot_ps(sign_bit, setup.depth_magnitude[k].sse()));
+    }
+    _mm_store_ps(setup.depth_error.v,
+                 _mm_add_ps(_mm_set1_ps(static_cast<float>(depth_error)),
+                            _mm_add_ps(setup.alpha.error.sse(), setup.beta.error.sse())));
+  }
+  setup.s_min.set(shadow->s_min);
+  setup.s_max.set(shadow->s_max);
   // The bounding box of the part of the shadow triangle that can hold a crossing: depth s in
   // [s_min, s_max], the quadrilateral x + s (a - x), x + s (b - x). Box against box is the
   // triangle-box test's box-axis half (Akenine-Möller 2001); with the free zone near x left
   // out, it also drops the surface x lies on before its leaf is reached. Rounded outwards.
-  __m128 region_lower[3], region_upper[3];
-  {
-    const Vec3 corners[4] = {x + shadow->s_min * shadow->to_a, x + shadow->s_min * shadow->to_b,
-                             x + shadow->s_max * shadow->to_a, x + shadow->s_max * shadow->to_b};
-    for (int k = 0; k < 3; ++k) {
-      double lower = corners[0][k], upper = corners[0][k];
-      for (const Vec3& corner : corners) {
-        lower = std::min(lower, corner[k]);
-        upper = std::max(upper, corner[k]);
-      }
-      // Rounding of the corners (double) and to float (half an ulp): 1e-6 of the coordinates
-      // involved covers both.
-      double slack = 1e-6 * (std::fabs(x[k]) + std::fabs(lower) + std::fabs(upper));
-      region_lower[k] = _mm_set1_ps(static_cast<float>(lower - slack));
-      region_upper[k] = _mm_set1_ps(static_cast<float>(upper + slack));
-    }
+  for (int k = 0; k < 3; ++k) {
+    // Per axis the corners are x + s v with s in {s_min, s_max} (both > 0) and v in
+    // {to_a, to_b}: the extremes take s_max where v is on the far side of 0.
+    const double v_lower = std::min(shadow->to_a[k], shadow->to_b[k]);
+    const double v_upper = std::max(shadow->to_a[k], shadow->to_b[k]);
+    const double lower = x[k] + (v_lower < 0 ? shadow->s_max : shadow->s_min) * v_lower;
+    const double upper = x[k] + (v_upper > 0 ? shadow->s_max : shadow->s_min) * v_upper;
+    // Rounding of the corners (double) and to float (half an ulp): 1e-6 of the coordinates
+    // involved covers both.
+    const double slack = 1e-6 * (std::fabs(x[k]) + std::fabs(lower) + std::fabs(upper));
+    setup.region_lower[k].set(lower - slack);
+    setup.region_upper[k].set(upper + slack);
   }
+  const NodeTest test_children = use_avx_ ? node_test_avx : test_children_sse;
 
-  // Prefetch only when the structure is larger than a typical L2 cache.
-  const bool prefetch =
-      nodes_.size() * sizeof(Node) + triangles_.size() * sizeof(OccluderTriangle) >
-      (size_t{1} << 20);
+  const bool prefetch = prefetch_;
   StackEntry stack[kStackCapacity];
   int top = 0;
   stack[top++] = {0, 0.0f, 1.0f};
   uint64_t nodes_visited = 0, triangles_tested = 0, cuts = 0;
+  ChildRanges ranges;
 
   while (top > 0) {
     const StackEntry entry = stack[--top];
-    // Skip what cuts found since the push have covered.
-    if (!out.overlaps(entry.t_lower - kProjectionSlack, entry.t_upper + kProjectionSlack)) continue;
+    // Skip what cuts found since the push have covered. (Before the first cut the whole
+    // segment is visible and every pushed range, within [0,1], overlaps it.)
+    if (cuts != 0 &&
+        !out.overlaps(entry.t_lower - kProjectionSlack, entry.t_upper + kProjectionSlack))
+      continue;
 
     if (entry.code & kLeafFlag) {
       // Leaf: exact crossings in double.
@@ -421,70 +630,17 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
 
     const Node& node = nodes_[entry.code];
     ++nodes_visited;
-    const __m128 center[3] = {_mm_load_ps(node.center[0]), _mm_load_ps(node.center[1]),
-                              _mm_load_ps(node.center[2])};
-    const __m128 extent[3] = {_mm_load_ps(node.extent[0]), _mm_load_ps(node.extent[1]),
-                              _mm_load_ps(node.extent[2])};
-    // Cheapest tests first: the box against the crossing region's bounding box and against
-    // the shadow plane (|distance| <= radius). Most rejected nodes fail one of these, and then
-    // the alpha/beta/depth ranges are never computed. Ordered comparisons: NaN centres (empty
-    // slots) fail.
-    __m128 keep = _mm_setzero_ps();
-    keep = _mm_cmpeq_ps(keep, keep);  // all ones
-    for (int k = 0; k < 3; ++k) {
-      keep = _mm_and_ps(keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), region_upper[k]));
-      keep = _mm_and_ps(keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), region_lower[k]));
-    }
-    if (_mm_movemask_ps(keep) == 0) continue;
-    __m128 distance_middle, distance_radius;
-    distance_range.evaluate(center, extent, distance_middle, distance_radius);
-    keep =
-        _mm_and_ps(keep, _mm_cmple_ps(_mm_andnot_ps(sign_bit, distance_middle), distance_radius));
-    if (_mm_movemask_ps(keep) == 0) continue;
-
-    __m128 alpha_middle, alpha_radius, beta_middle, beta_radius, depth_middle, depth_radius;
-    alpha_range.evaluate(center, extent, alpha_middle, alpha_radius);
-    beta_range.evaluate(center, extent, beta_middle, beta_radius);
-    depth_middle = _mm_add_ps(alpha_middle, beta_middle);
-    depth_radius = depth_range.radius_of(extent);
-    __m128 alpha_lower = _mm_sub_ps(alpha_middle, alpha_radius);
-    __m128 alpha_upper = _mm_add_ps(alpha_middle, alpha_radius);
-    __m128 beta_lower = _mm_sub_ps(beta_middle, beta_radius);
-    __m128 beta_upper = _mm_add_ps(beta_middle, beta_radius);
-    __m128 depth_lower = _mm_sub_ps(depth_middle, depth_radius);
-    __m128 depth_upper = _mm_add_ps(depth_middle, depth_radius);
-    // The side planes through x (alpha >= 0, beta >= 0), the plane through the segment
-    // (s <= s_max) and the self-occlusion plane (s >= s_min).
-    keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
-    keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
-    keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, s_min));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, s_max));
-    int mask = _mm_movemask_ps(keep);
+    unsigned mask = test_children(node, setup, ranges);
     if (mask == 0) continue;
-
-    // Project the boxes from x onto the segment. Within the wedge (alpha, beta >= 0),
-    // t = beta / (alpha + beta) grows with beta and falls with alpha, so over the box's
-    // [alpha] x [beta] rectangle its range is [beta_lo / (alpha_hi + beta_lo),
-    // beta_hi / (alpha_lo + beta_hi)] with negative bounds clamped to 0.
-    __m128 beta_lower_clamped = _mm_max_ps(beta_lower, zero);
-    __m128 alpha_lower_clamped = _mm_max_ps(alpha_lower, zero);
-    __m128 t_lower = _mm_div_ps(beta_lower_clamped,
-                                _mm_max_ps(_mm_add_ps(alpha_upper, beta_lower_clamped), tiny));
-    __m128 t_upper =
-        _mm_div_ps(beta_upper, _mm_max_ps(_mm_add_ps(alpha_lower_clamped, beta_upper), tiny));
-    alignas(16) float t_lowers[4], t_uppers[4], depth_lowers[4];
-    _mm_store_ps(t_lowers, t_lower);
-    _mm_store_ps(t_uppers, t_upper);
-    _mm_store_ps(depth_lowers, depth_lower);
 
     // Surviving children, nearest to x first. (Whether their projection is already occluded
     // is checked when they are popped.)
-    int order[4];
+    int order[kWidth];
     int kept = 0;
-    for (int slot = 0; slot < 4; ++slot) {
-      if (!(mask & (1 << slot))) continue;
+    for (; mask != 0; mask &= mask - 1) {
+      const int slot = __builtin_ctz(mask);
       int position = kept++;
-      while (position > 0 && depth_lowers[order[position - 1]] > depth_lowers[slot]) {
+      while (position > 0 && ranges.depth_lower[order[position - 1]] > ranges.depth_lower[slot]) {
         order[position] = order[position - 1];
         --position;
       }
@@ -492,9 +648,9 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     }
     // Push far to near so the nearest is popped first.
     for (int i = kept - 1; i >= 0; --i) {
-      int slot = order[i];
-      uint32_t code = node.child[slot];
-      stack[top++] = {code, t_lowers[slot], t_uppers[slot]};
+      const int slot = order[i];
+      const uint32_t code = node.child[slot];
+      stack[top++] = {code, ranges.t_lower[slot], ranges.t_upper[slot]};
       // Start loading it now: the walk is bound by memory on large scenes (small ones stay in
       // cache, and the prefetches would only cost instructions).
       if (!prefetch) continue;
@@ -505,8 +661,8 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
         _mm_prefetch(leaf + 64, _MM_HINT_T0);
       } else {
         const char* child = reinterpret_cast<const char*>(&nodes_[code]);
-        _mm_prefetch(child, _MM_HINT_T0);
-        _mm_prefetch(child + 64, _MM_HINT_T0);
+        for (size_t line = 0; line < sizeof(Node); line += 64)
+          _mm_prefetch(child + line, _MM_HINT_T0);
       }
     }
   }
@@ -540,7 +696,7 @@ bool LineQuery::occluded(const Vec3& x, const Vec3& p) const {
       continue;
     }
     const Node& node = nodes_[code];
-    for (int slot = 0; slot < 4; ++slot) {
+    for (int slot = 0; slot < kWidth; ++slot) {
       if (std::isnan(node.center[0][slot])) continue;
       // Slab test of the parameter range [0, 1] of x + s (p - x).
       double enter = 0, exit = 1;

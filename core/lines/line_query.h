@@ -3,11 +3,13 @@
 // 2019 Sec. 4): which parts of a segment a->b on a light are visible from a shading point x.
 // It is the cost centre of line sampling, so it has its own acceleration structure:
 //
-// - a 4-wide BVH (BVH4) built by Embree's rtcBuildBVH (SAH, MEDIUM quality by default) through
+// - an 8-wide BVH (BVH8) built by Embree's rtcBuildBVH (SAH, MEDIUM quality by default) through
 //   our own node callbacks, then flattened into one array of nodes with float boxes stored
 //   structure-of-arrays, and leaf triangles stored contiguously in leaf order (float vertices
 //   in canonical order, OccluderTriangle);
-// - our own traversal: the four child boxes of a node are tested together (SSE) against the
+// - our own traversal: the eight child boxes of a node are tested together (AVX when the CPU
+//   has it, chosen at run time; otherwise two SSE halves doing the same float operations per
+//   lane, so both paths make the same decisions bit for bit) against the
 //   shadow triangle's plane, its three side planes, the self-occlusion plane near x and the
 //   bounding box of the region that can hold a crossing, with a conservative float error
 //   bound; each surviving child's box is projected from x onto the segment and skipped when
@@ -37,6 +39,9 @@ struct LineQueryOptions {
   // Embree's SAH builder quality. HIGH runs without spatial splits (no split callback).
   LineQueryBuildQuality build_quality = LineQueryBuildQuality::Medium;
   unsigned max_leaf_size = 4;  // triangles per leaf
+  // Test nodes with AVX when the CPU has it. The SSE path computes the same floats lane by lane
+  // (tests compare both): results and culling do not depend on it, only speed.
+  bool allow_avx = true;
 };
 
 // Counters of one or more queries (for benchmarks and tests of the culling).
@@ -71,14 +76,18 @@ class LineQuery {
   size_t node_count() const { return nodes_.size(); }
   const LineQueryOptions& options() const { return options_; }
 
-  // One BVH4 node: the boxes of its four children as centre and half extent (each box
-  // contains the children's float boxes), structure-of-arrays so one SSE register holds one
-  // coordinate of all four. Empty slots have a NaN centre (every test rejects them).
+  // One BVH8 node: the boxes of its eight children as centre and half extent (each box
+  // contains the children's float boxes), structure-of-arrays so one AVX register (or two SSE
+  // registers) holds one coordinate of all eight. Empty slots have a NaN centre (every test
+  // rejects them).
+  static constexpr int kWidth = 8;
   struct alignas(64) Node {
-    float center[3][4];  // [axis][child]
-    float extent[3][4];  // [axis][child], >= 0
-    uint32_t child[4];   // inner node index, or kLeafFlag | first << kCountBits | count - 1
+    float center[3][kWidth];  // [axis][child]
+    float extent[3][kWidth];  // [axis][child], >= 0
+    uint32_t child[kWidth];   // inner node index, or kLeafFlag | first << kCountBits | count - 1
   };
+  // True when queries test nodes with AVX (options().allow_avx and the CPU has AVX).
+  bool uses_avx() const { return use_avx_; }
   static constexpr uint32_t kLeafFlag = 0x80000000u;
   static constexpr uint32_t kCountBits = 5;  // up to 32 triangles per leaf
 
@@ -88,7 +97,9 @@ class LineQuery {
   LineQueryOptions options_;
   std::vector<Node> nodes_;                  // nodes_[0] is the root
   std::vector<OccluderTriangle> triangles_;  // in leaf order
-  Vec3 scene_max_abs_;  // per axis, the largest |coordinate| (float error bounds)
+  Vec3 scene_max_abs_;     // per axis, the largest |coordinate| (float error bounds)
+  bool prefetch_ = false;  // nodes and triangles exceed a typical L2 cache: prefetch children
+  bool use_avx_ = false;
 };
 
 }  // namespace penumbra

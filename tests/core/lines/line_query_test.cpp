@@ -210,6 +210,43 @@ TEST(LineQuery, MatchesBruteForceWithEveryBuildQualityAndLeafSize) {
   }
 }
 
+TEST(LineQuery, SseAndAvxNodeTestsKeepTheSameChildren) {
+  // The node test runs with AVX when the CPU has it, otherwise as two SSE halves doing the
+  // same float operations per lane: the answers, and the culling itself (nodes, triangles and
+  // cuts counted), must be the same bits either way. (On a CPU without AVX both builds take
+  // the SSE path and the test still checks the brute force.)
+  TriangleMesh mesh = random_triangles_mesh(4000, {-1, -1, -1}, {1, 1, 1}, 0.05, 11);
+  mesh.append(floor_grid(1.5, -1.05, 8));
+  LineQueryOptions sse_only;
+  sse_only.allow_avx = false;
+  LineQuery sse_query(mesh.positions, mesh.indices, sse_only);
+  LineQuery default_query(mesh.positions, mesh.indices);
+  EXPECT_FALSE(sse_query.uses_avx());
+  Random random(12);
+  LineQueryStats sse_stats, default_stats;
+  int partially_visible = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    Vec3 x = random.in_box({-1, -1.05, -1}, {1, 0, 1});
+    Vec3 a = random.in_box({-1, 1.2, -1}, {1, 2, 1});
+    Vec3 b = a + 0.4 * random.direction();
+    IntervalList sse_answer, default_answer;
+    sse_query.visible_intervals(x, a, b, sse_answer, &sse_stats);
+    default_query.visible_intervals(x, a, b, default_answer, &default_stats);
+    ASSERT_EQ(sse_answer.size(), default_answer.size()) << trial;
+    for (size_t i = 0; i < sse_answer.size(); ++i) {
+      EXPECT_EQ(sse_answer[i].lo, default_answer[i].lo) << trial;
+      EXPECT_EQ(sse_answer[i].hi, default_answer[i].hi) << trial;
+    }
+    if (trial % 10 == 0)
+      expect_same_intervals(sse_answer, brute_force(mesh, x, a, b), "sse vs brute force");
+    partially_visible += !sse_answer.fully_occluded() && sse_answer.visible_length() < 1;
+  }
+  EXPECT_EQ(sse_stats.nodes_visited, default_stats.nodes_visited);
+  EXPECT_EQ(sse_stats.triangles_tested, default_stats.triangles_tested);
+  EXPECT_EQ(sse_stats.cuts, default_stats.cuts);
+  EXPECT_GT(partially_visible, 60);
+}
+
 TEST(LineQuery, MatchesBruteForceOnBoxesAndGridsWithIntegerQueries) {
   // Boxes on an integer lattice, a floor grid and a wall; shading points and segments on the
   // lattice too, so shadow planes pass exactly through vertices and along edges.
