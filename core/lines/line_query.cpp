@@ -104,41 +104,46 @@ Vec3 absolute(const Vec3& v) {
 // Traversal. The node test needs, per query, a few linear functions f(p) = dot(gradient, p) +
 // offset over boxes: their value at a box's centre (`middle`) and a radius, so that
 // [middle - radius, middle + radius] contains the exact range of f over the box. The constants
-// are floats stored four times over (Lanes4): the SSE test loads them as they are, the AVX test
-// broadcasts the first.
+// are stored as floats, once: the AVX test broadcasts them from memory (one instruction), the
+// SSE test with a load and a shuffle.
 
-struct alignas(16) Lanes4 {
-  float v[4];
-  void set(double value) { _mm_store_ps(v, _mm_set1_ps(static_cast<float>(value))); }
-  __m128 sse() const { return _mm_load_ps(v); }
-};
+inline __m128 sse(float value) {
+  return _mm_set1_ps(value);
+}
+
+// Three doubles rounded to float (as static_cast<float> does, lane by lane) in lanes 0-2.
+inline __m128 to_floats(const Vec3& v) {
+  return _mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(v.y, v.x)), _mm_cvtpd_ps(_mm_set_sd(v.z)));
+}
 
 struct LinearFunction {
-  Lanes4 gradient[3], magnitude[3], offset, error;
+  alignas(16) float gradient[4];   // lanes 0-2
+  alignas(16) float magnitude[4];  // |gradient|
+  float offset, error;
 
   // `coordinate_bound` is max |p| over the scene plus |x|, per axis (computed once per query).
   void set(const Vec3& gradient_d, const Vec3& x, const Vec3& coordinate_bound) {
     // Float error of evaluating dot(g, c) + offset and dot(|g|, e) with g, offset, c, e rounded
     // to float: a few ulps of the largest partial sum, bounded by |g|.(max |p| + |x|) since
     // centres and extents are bounded by the scene's extent; 32 ulps to be safe.
-    error.set(32 * (FLT_EPSILON / 2) * dot(absolute(gradient_d), coordinate_bound));
-    offset.set(-dot(gradient_d, x));
+    error =
+        static_cast<float>(32 * (FLT_EPSILON / 2) * dot(absolute(gradient_d), coordinate_bound));
+    offset = static_cast<float>(-dot(gradient_d, x));
     // |float(g)| == float(|g|) (rounding is symmetric): the magnitudes are the gradients with
     // the sign bit cleared.
-    const __m128 sign_bit = _mm_set1_ps(-0.0f);
-    for (int k = 0; k < 3; ++k) {
-      gradient[k].set(gradient_d[k]);
-      _mm_store_ps(magnitude[k].v, _mm_andnot_ps(sign_bit, gradient[k].sse()));
-    }
+    const __m128 rounded = to_floats(gradient_d);
+    _mm_store_ps(gradient, rounded);
+    _mm_store_ps(magnitude, _mm_andnot_ps(_mm_set1_ps(-0.0f), rounded));
   }
 };
 
 // Everything the node test needs from one query.
 struct NodeTestSetup {
-  Lanes4 region_lower[3], region_upper[3];  // bounding box of the crossing region
-  LinearFunction distance, alpha, beta;     // see shadow_triangle.h
-  Lanes4 depth_magnitude[3], depth_error;   // depth s = alpha + beta: radius only
-  Lanes4 s_min, s_max;
+  float region_lower[3], region_upper[3];  // bounding box of the crossing region
+  LinearFunction distance, alpha, beta;    // see shadow_triangle.h
+  alignas(16) float depth_magnitude[4];    // depth s = alpha + beta: radius only
+  float depth_error;
+  float s_min, s_max;
 };
 
 // What the node test returns for each surviving child: the t-range its box projects to on the
@@ -171,14 +176,14 @@ unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& set
   const __m128 tiny = _mm_set1_ps(FLT_MIN);
   const __m128 sign_bit = _mm_set1_ps(-0.0f);
   auto middle_of = [](const LinearFunction& f, const __m128 center[3]) {
-    return _mm_add_ps(_mm_add_ps(f.offset.sse(), _mm_mul_ps(f.gradient[0].sse(), center[0])),
-                      _mm_add_ps(_mm_mul_ps(f.gradient[1].sse(), center[1]),
-                                 _mm_mul_ps(f.gradient[2].sse(), center[2])));
+    return _mm_add_ps(_mm_add_ps(sse(f.offset), _mm_mul_ps(sse(f.gradient[0]), center[0])),
+                      _mm_add_ps(_mm_mul_ps(sse(f.gradient[1]), center[1]),
+                                 _mm_mul_ps(sse(f.gradient[2]), center[2])));
   };
-  auto radius_of = [](const Lanes4& error, const Lanes4 magnitude[3], const __m128 extent[3]) {
-    return _mm_add_ps(_mm_add_ps(error.sse(), _mm_mul_ps(magnitude[0].sse(), extent[0])),
-                      _mm_add_ps(_mm_mul_ps(magnitude[1].sse(), extent[1]),
-                                 _mm_mul_ps(magnitude[2].sse(), extent[2])));
+  auto radius_of = [](float error, const float magnitude[3], const __m128 extent[3]) {
+    return _mm_add_ps(_mm_add_ps(sse(error), _mm_mul_ps(sse(magnitude[0]), extent[0])),
+                      _mm_add_ps(_mm_mul_ps(sse(magnitude[1]), extent[1]),
+                                 _mm_mul_ps(sse(magnitude[2]), extent[2])));
   };
   unsigned result = 0;
   for (int half = 0; half < LineQuery::kWidth; half += 4) {
@@ -188,14 +193,14 @@ unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& set
     const __m128 extent[3] = {_mm_load_ps(node.extent[0] + half),
                               _mm_load_ps(node.extent[1] + half),
                               _mm_load_ps(node.extent[2] + half)};
-    __m128 keep = _mm_cmple_ps(_mm_sub_ps(center[0], extent[0]), setup.region_upper[0].sse());
+    __m128 keep = _mm_cmple_ps(_mm_sub_ps(center[0], extent[0]), sse(setup.region_upper[0]));
     keep = _mm_and_ps(keep,
-                      _mm_cmpge_ps(_mm_add_ps(center[0], extent[0]), setup.region_lower[0].sse()));
+                      _mm_cmpge_ps(_mm_add_ps(center[0], extent[0]), sse(setup.region_lower[0])));
     for (int k = 1; k < 3; ++k) {
-      keep = _mm_and_ps(
-          keep, _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), setup.region_upper[k].sse()));
-      keep = _mm_and_ps(
-          keep, _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), setup.region_lower[k].sse()));
+      keep = _mm_and_ps(keep,
+                        _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), sse(setup.region_upper[k])));
+      keep = _mm_and_ps(keep,
+                        _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), sse(setup.region_lower[k])));
     }
     if (_mm_movemask_ps(keep) == 0) continue;
     const __m128 distance_middle = middle_of(setup.distance, center);
@@ -219,8 +224,8 @@ unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& set
     const __m128 depth_upper = _mm_add_ps(depth_middle, depth_radius);
     keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
     keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
-    keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, setup.s_min.sse()));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, setup.s_max.sse()));
+    keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, sse(setup.s_min)));
+    keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, sse(setup.s_max)));
     const unsigned mask = static_cast<unsigned>(_mm_movemask_ps(keep));
     if (mask == 0) continue;
 
@@ -243,8 +248,8 @@ unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& set
 #define PENUMBRA_AVX __attribute__((target("avx"), always_inline)) inline
 
 // AVX helpers of the node test (lambdas would not inherit the target attribute).
-PENUMBRA_AVX __m256 lanes(const Lanes4& value) {
-  return _mm256_broadcast_ss(value.v);
+PENUMBRA_AVX __m256 lanes(const float& value) {
+  return _mm256_broadcast_ss(&value);
 }
 PENUMBRA_AVX __m256 middle_of(const LinearFunction& f, const __m256 center[3]) {
   return _mm256_add_ps(
@@ -252,7 +257,7 @@ PENUMBRA_AVX __m256 middle_of(const LinearFunction& f, const __m256 center[3]) {
       _mm256_add_ps(_mm256_mul_ps(lanes(f.gradient[1]), center[1]),
                     _mm256_mul_ps(lanes(f.gradient[2]), center[2])));
 }
-PENUMBRA_AVX __m256 radius_of(const Lanes4& error, const Lanes4 magnitude[3],
+PENUMBRA_AVX __m256 radius_of(const float& error, const float magnitude[3],
                               const __m256 extent[3]) {
   return _mm256_add_ps(_mm256_add_ps(lanes(error), _mm256_mul_ps(lanes(magnitude[0]), extent[0])),
                        _mm256_add_ps(_mm256_mul_ps(lanes(magnitude[1]), extent[1]),
@@ -564,18 +569,12 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     const Vec3 depth_gradient = shadow->alpha_gradient + shadow->beta_gradient;
     const double depth_error =
         32 * (FLT_EPSILON / 2) * dot(absolute(depth_gradient), coordinate_bound);
-    const __m128 sign_bit = _mm_set1_ps(-0.0f);
-    for (int k = 0; k < 3; ++k) {
-      setup.depth_magnitude[k].set(depth_gradient[k]);
-      _mm_store_ps(setup.depth_magnitude[k].v,
-                   _mm_andnot_ps(sign_bit, setup.depth_magnitude[k].sse()));
-    }
-    _mm_store_ps(setup.depth_error.v,
-                 _mm_add_ps(_mm_set1_ps(static_cast<float>(depth_error)),
-                            _mm_add_ps(setup.alpha.error.sse(), setup.beta.error.sse())));
+    _mm_store_ps(setup.depth_magnitude,
+                 _mm_andnot_ps(_mm_set1_ps(-0.0f), to_floats(depth_gradient)));
+    setup.depth_error = static_cast<float>(depth_error) + (setup.alpha.error + setup.beta.error);
   }
-  setup.s_min.set(shadow->s_min);
-  setup.s_max.set(shadow->s_max);
+  setup.s_min = static_cast<float>(shadow->s_min);
+  setup.s_max = static_cast<float>(shadow->s_max);
   // The bounding box of the part of the shadow triangle that can hold a crossing: depth s in
   // [s_min, s_max], the quadrilateral x + s (a - x), x + s (b - x). Box against box is the
   // triangle-box test's box-axis half (Akenine-Möller 2001); with the free zone near x left
@@ -590,8 +589,8 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
     // Rounding of the corners (double) and to float (half an ulp): 1e-6 of the coordinates
     // involved covers both.
     const double slack = 1e-6 * (std::fabs(x[k]) + std::fabs(lower) + std::fabs(upper));
-    setup.region_lower[k].set(lower - slack);
-    setup.region_upper[k].set(upper + slack);
+    setup.region_lower[k] = static_cast<float>(lower - slack);
+    setup.region_upper[k] = static_cast<float>(upper + slack);
   }
   const NodeTest test_children = use_avx_ ? node_test_avx : test_children_sse;
 
