@@ -1,3 +1,6 @@
+// `penumbra stability [-o DIR]`: every method against every adversarial configuration
+// (core/analysis/stability.h): the method-by-case table of bias and non-finite counts.
+//
 // `penumbra reproduce [--quick|--full] [-o DIR]`: reruns the papers' experiments
 // (core/analysis/reproduction_suite.h), prints one table (paper figure beside ours, with pass or
 // fail), writes one chart per figure (SVG and PNG) and the table as JSON into DIR. Exit code 4
@@ -11,6 +14,7 @@
 
 #include "client/commands.h"
 #include "core/analysis/reproduction_suite.h"
+#include "core/analysis/stability.h"
 
 namespace penumbra {
 
@@ -53,6 +57,41 @@ void run_reproduce(const ReproduceArgs& args) {
   if (!report.passed()) set_command_exit_code(4);
 }
 
+struct StabilityArgs {
+  std::string output = "stability-out";
+  int trials = 256, samples = 4;
+};
+
+void run_stability_command(const StabilityArgs& args) {
+  StabilityOptions options;
+  options.trials = args.trials;
+  options.samples = args.samples;
+  options.progress = [](const std::string& line) {
+    std::fprintf(stderr, "stability: %s\n", line.c_str());
+  };
+  StabilityTable table = run_stability(options);
+  std::string markdown = stability_markdown(table);
+  std::printf("%s", markdown.c_str());
+  std::filesystem::create_directories(args.output);
+  for (auto [name, text] :
+       {std::pair{"stability.md", markdown}, std::pair{"stability.json", stability_json(table)}}) {
+    std::filesystem::path path = std::filesystem::path(args.output) / name;
+    std::ofstream out(path);
+    out << text << "\n";
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+  }
+  uint64_t nonfinite = 0, inconsistent = 0;
+  for (const StabilityCell& cell : table.cells) {
+    nonfinite += cell.nonfinite;
+    inconsistent += !cell.refused && !cell.consistent;
+  }
+  std::printf(
+      "%llu non-finite estimates, %llu inconsistent cells; wrote stability.md and "
+      "stability.json to %s\n",
+      (unsigned long long)nonfinite, (unsigned long long)inconsistent, args.output.c_str());
+  if (nonfinite) set_command_exit_code(4);
+}
+
 }  // namespace
 
 void add_reproduce_command(CLI::App& app) {
@@ -67,6 +106,16 @@ void add_reproduce_command(CLI::App& app) {
   reproduce->add_option("--threads", args->threads, "Threads (0: all cores)")
       ->check(CLI::Range(0, 1024));
   reproduce->callback([args] { run_reproduce(*args); });
+
+  auto stability_args = std::make_shared<StabilityArgs>();
+  CLI::App* stability = app.add_subcommand(
+      "stability", "Every method against adversarial configurations: bias and NaN/Inf table");
+  stability->add_option("-o,--output", stability_args->output, "Output folder (md, json)");
+  stability->add_option("--trials", stability_args->trials, "Estimates per method and case")
+      ->check(CLI::Range(2, 1 << 20));
+  stability->add_option("--samples", stability_args->samples, "Samples per estimate (N)")
+      ->check(CLI::Range(1, 1 << 16));
+  stability->callback([stability_args] { run_stability_command(*stability_args); });
 }
 
 }  // namespace penumbra
