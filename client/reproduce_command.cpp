@@ -83,7 +83,7 @@ void run_stability_command(const StabilityArgs& args) {
   uint64_t nonfinite = 0, inconsistent = 0;
   for (const StabilityCell& cell : table.cells) {
     nonfinite += cell.nonfinite;
-    inconsistent += !cell.refused && !cell.consistent;
+    inconsistent += !cell.refused && !cell.consistent && cell.expected_unconverged.empty();
   }
   std::printf(
       "%llu non-finite estimates, %llu inconsistent cells; wrote stability.md and "
