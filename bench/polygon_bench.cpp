@@ -1,10 +1,17 @@
-// Samples per second per thread of Peters' solid angle (sa) and projected solid angle (psa)
-// sampling of 3-, 4- and 5-gons, central and decentral (cf. Peters 2021, Table 1). Two columns
-// as in the paper: "per light" prepares the polygon for every sample (one sample per shading
-// point and light), "per sample" prepares once and draws many samples. The goal (PERFORMANCE.md)
-// is psa within 4x of sa; compare ratios from one run.
+// Samples per second per thread of the polygon samplers on 3-, 4- and 5-gons, central and
+// decentral (cf. Peters 2021, Table 1). Two columns as in the paper: "per light" prepares the
+// polygon for every sample (one sample per shading point and light), "per sample" prepares once
+// and draws many samples. The goal (PERFORMANCE.md) is psa within 4x of sa; compare ratios from
+// one run.
 //
-//   polygon_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// Two levels:
+// - samplers of directions (sa_*: Peters' solid angle sampling, core/polygon/solid_angle_polygon.h;
+//   sa_arvo_*: Arvo's original, core/polygon/arvo_solid_angle.h; psa_*), as in the paper;
+// - the point strategies the estimator runs (strategy_<name>_*: area, sa, psa, ltc on a ggx
+//   material), which add the plane hit and the area-measure pdf: what a method pays.
+//
+//   polygon_bench --benchmark_filter=per_ --benchmark_repetitions=5
+//                 --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 
@@ -13,8 +20,14 @@
 #include <vector>
 
 #include "core/math/vec.h"
+#include "core/polygon/arvo_solid_angle.h"
+#include "core/polygon/ltc_strategy.h"
+#include "core/polygon/peters_sa_strategy.h"
 #include "core/polygon/projected_solid_angle.h"
+#include "core/polygon/psa_strategy.h"
 #include "core/polygon/solid_angle_polygon.h"
+#include "core/strategies/area_strategy.h"
+#include "core/strategies/solid_angle_strategy.h"
 
 namespace penumbra {
 namespace {
@@ -85,6 +98,12 @@ void sa_per_light(benchmark::State& s) {
 void sa_per_sample(benchmark::State& s) {
   per_sample<SolidAnglePolygonSampler>(s, true);
 }
+void sa_arvo_per_light(benchmark::State& s) {
+  per_light<ArvoPolygonSampler>(s, true);
+}
+void sa_arvo_per_sample(benchmark::State& s) {
+  per_sample<ArvoPolygonSampler>(s, true);
+}
 void psa_central_per_light(benchmark::State& s) {
   per_light<ProjectedSolidAngleSampler>(s, true);
 }
@@ -99,11 +118,87 @@ void psa_decentral_per_sample(benchmark::State& s) {
 }
 
 BENCHMARK(sa_per_light)->DenseRange(3, 5);
+BENCHMARK(sa_arvo_per_light)->DenseRange(3, 5);
 BENCHMARK(psa_central_per_light)->DenseRange(3, 5);
 BENCHMARK(psa_decentral_per_light)->DenseRange(3, 5);
 BENCHMARK(sa_per_sample)->DenseRange(3, 5);
+BENCHMARK(sa_arvo_per_sample)->DenseRange(3, 5);
 BENCHMARK(psa_central_per_sample)->DenseRange(3, 5);
 BENCHMARK(psa_decentral_per_sample)->DenseRange(3, 5);
+
+// The point strategies on the same polygons as polygon lights (emitting towards the shading
+// point at the origin, normal +z; a ggx material for ltc, viewed obliquely).
+struct StrategySetup {
+  Material material;
+  std::vector<Light> lights;
+  ShadingPoint sp;
+  StrategySetup(int n, bool central) {
+    material.type = MaterialType::Ggx;
+    material.diffuse = {0.2, 0.2, 0.2};
+    material.specular = {0.8, 0.8, 0.8};
+    material.roughness = 0.2;
+    sp = ShadingPoint{{0, 0, 0}, {0, 0, 1}, normalize(Vec3{-0.6, 0.1, 1}), &material};
+    for (const auto& polygon : polygons(n, central)) {
+      Light light;
+      light.type = LightType::Polygon;
+      light.vertices = polygon;
+      Vec3 c = cross(polygon[1] - polygon[0], polygon[2] - polygon[0]);
+      light.normal = normalize(c);
+      double area = 0;
+      for (size_t i = 1; i + 1 < polygon.size(); ++i)
+        area += 0.5 * length(cross(polygon[i] - polygon[0], polygon[i + 1] - polygon[0]));
+      light.area = area;
+      Vec3 centroid;
+      for (const Vec3& v : polygon) centroid += v / double(polygon.size());
+      light.centroid = centroid;
+      lights.push_back(light);
+    }
+  }
+};
+
+template <typename Strategy>
+void strategy_per_light(benchmark::State& state, bool central) {
+  StrategySetup setup(int(state.range(0)), central);
+  auto u = random_pairs();
+  size_t i = 0;
+  for (auto _ : state) {
+    Strategy strategy(setup.sp, setup.lights[i % kConfigurations]);
+    benchmark::DoNotOptimize(strategy.sample(u[i % kRandomPairs]));
+    ++i;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+template <typename Strategy>
+void strategy_per_sample(benchmark::State& state, bool central) {
+  StrategySetup setup(int(state.range(0)), central);
+  auto u = random_pairs();
+  std::vector<Strategy> strategies;
+  for (const Light& light : setup.lights) strategies.emplace_back(setup.sp, light);
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(strategies[(i / 128) % kConfigurations].sample(u[i % kRandomPairs]));
+    ++i;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+#define PENUMBRA_STRATEGY_BENCH(name, Strategy, central)    \
+  void strategy_##name##_per_light(benchmark::State& s) {   \
+    strategy_per_light<Strategy>(s, central);               \
+  }                                                         \
+  void strategy_##name##_per_sample(benchmark::State& s) {  \
+    strategy_per_sample<Strategy>(s, central);              \
+  }                                                         \
+  BENCHMARK(strategy_##name##_per_light)->DenseRange(3, 5); \
+  BENCHMARK(strategy_##name##_per_sample)->DenseRange(3, 5);
+
+PENUMBRA_STRATEGY_BENCH(area, AreaStrategy, true)
+PENUMBRA_STRATEGY_BENCH(sa, SolidAngleStrategy, true)
+PENUMBRA_STRATEGY_BENCH(sa_polygon, PetersSolidAngleStrategy, true)
+PENUMBRA_STRATEGY_BENCH(psa_central, ProjectedSolidAngleStrategy, true)
+PENUMBRA_STRATEGY_BENCH(psa_decentral, ProjectedSolidAngleStrategy, false)
+PENUMBRA_STRATEGY_BENCH(ltc, LtcStrategy, true)
 
 // The backward-error statistic of METHODS.md on the full 10^6 random configurations (the unit
 // test runs 2*10^5 unless PENUMBRA_FULL_TESTS=1); reported as counters, timed for information.

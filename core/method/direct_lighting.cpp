@@ -15,6 +15,7 @@
 #include "core/polygon/ltc_strategy.h"
 #include "core/polygon/ltc_unshadowed_shading.h"
 #include "core/polygon/peters_mis.h"
+#include "core/polygon/polygon_light.h"
 #include "core/polygon/psa_strategy.h"
 #include "core/strategies/area_strategy.h"
 #include "core/strategies/bsdf_strategy.h"
@@ -428,6 +429,12 @@ DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
           if (scene.lights[l].type == LightType::Disk)
             refuse(method, "strategy \"" + name + "\" samples polygons and quads; light " +
                                std::to_string(l) + " is a disk (use sa or area)");
+          else if (!is_polygon_light(scene.lights[l]))
+            refuse(method, "strategy \"" + name + "\" samples polygons of up to " +
+                               std::to_string(kMaxPolygonVertices) + " vertices; light " +
+                               std::to_string(l) + " has " +
+                               std::to_string(scene.lights[l].vertices.size()) +
+                               " (use sa or area)");
         break;
       case StrategyKind::LineArea:
       case StrategyKind::LineSolidAngle:

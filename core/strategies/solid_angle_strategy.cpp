@@ -2,6 +2,7 @@
 
 #include "core/lights/light_geometry.h"
 #include "core/math/spherical_triangle.h"
+#include "core/polygon/solid_angle_polygon.h"
 
 namespace penumbra {
 namespace {
@@ -40,29 +41,20 @@ SolidAngleStrategy::SolidAngleStrategy(const ShadingPoint& sp, const Light& ligh
     }
     solid_angle_ = 2.0 * kPi * cone_one_minus_cos_;
     domain_ = Domain::Cone;
-  } else {
-    // Quads that are not rectangles, and polygons: the triangle fan.
-    size_t n = light.vertices.size();
-    if (n < 3) return;
-    fan_triangles_ = n - 2;
-    double total = 0;
-    for (size_t i = 0; i < fan_triangles_; ++i) {
-      double omega = fan_triangle_solid_angle(i);
-      if (i < kCachedFanTriangles) fan_solid_angles_[i] = omega;
-      total += omega;
-    }
-    solid_angle_ = total;
+  } else if (is_polygon_light(light)) {
+    // Quads that are not rectangles, and polygons: Peters' triangle fan.
+    fan_.emplace(sp, light);
+    solid_angle_ = fan_->solid_angle();
     domain_ = Domain::Fan;
+  } else if (light.vertices.size() >= 3) {
+    // More vertices than the polygon samplers' fixed arrays hold.
+    for (size_t i = 0; i + 2 < light.vertices.size(); ++i) solid_angle_ += large_fan_triangle(i);
+    domain_ = Domain::LargeFan;
   }
   if (!(solid_angle_ > 0) || !std::isfinite(solid_angle_)) {
     domain_ = Domain::None;
     solid_angle_ = 0;
   }
-}
-
-double SolidAngleStrategy::fan_triangle_solid_angle(size_t i) const {
-  const std::vector<Vec3>& v = light_->vertices;
-  return triangle_solid_angle(v[0] - x_, v[i + 1] - x_, v[i + 2] - x_);
 }
 
 std::optional<LightPoint> SolidAngleStrategy::sample(const Vec2& u_in) const {
@@ -73,39 +65,41 @@ std::optional<LightPoint> SolidAngleStrategy::sample(const Vec2& u_in) const {
     case Domain::Rectangle:
       return finish(rectangle_.sample(u));
     case Domain::Fan:
-      return sample_fan(u);
+      return fan_->sample(u);
+    case Domain::LargeFan:
+      return sample_large_fan(u);
     case Domain::Cone:
       return sample_cone(u);
   }
   return std::nullopt;
 }
 
-std::optional<LightPoint> SolidAngleStrategy::sample_fan(const Vec2& u) const {
-  // Choose a triangle of the fan by its solid angle, then reuse u.x inside it. Rounding
-  // leftovers (target >= the sum) go to the last triangle with a solid angle.
-  double target = u.x * solid_angle_;
-  double begin = 0, chosen_begin = 0, chosen_omega = 0;
-  size_t chosen = fan_triangles_;
-  for (size_t i = 0; i < fan_triangles_; ++i) {
-    double omega = i < kCachedFanTriangles ? fan_solid_angles_[i] : fan_triangle_solid_angle(i);
-    if (omega > 0) {
-      chosen = i;
-      chosen_begin = begin;
-      chosen_omega = omega;
-      if (target < begin + omega) break;
-    }
-    begin += omega;
-  }
-  if (chosen == fan_triangles_) return std::nullopt;
-  double u_in_triangle = std::clamp((target - chosen_begin) / chosen_omega, 0.0, 1.0);
+double SolidAngleStrategy::large_fan_triangle(size_t i) const {
   const std::vector<Vec3>& v = light_->vertices;
-  auto triangle = SphericalTriangle::prepare(normalize(v[0] - x_), normalize(v[chosen + 1] - x_),
-                                             normalize(v[chosen + 2] - x_), chosen_omega);
-  if (!triangle) return std::nullopt;
-  Vec3 direction = triangle->sample({u_in_triangle, u.y});
-  // The point where the direction meets the light's plane.
-  double denominator = dot(light_->normal, direction);
-  double distance = light_plane_height(*light_, x_) / -denominator;
+  return triangle_solid_angle(v[0] - x_, v[i + 1] - x_, v[i + 2] - x_);
+}
+
+std::optional<LightPoint> SolidAngleStrategy::sample_large_fan(const Vec2& u) const {
+  // A fan triangle chosen by its solid angle, u.x reused inside it (as SolidAnglePolygonSampler).
+  const std::vector<Vec3>& v = light_->vertices;
+  double target = u.x * solid_angle_, before = 0, chosen_begin = 0, chosen_omega = 0;
+  size_t chosen = 0;
+  for (size_t i = 0; i + 2 < v.size(); ++i) {
+    double omega = large_fan_triangle(i);
+    if (!(omega > 0)) continue;
+    chosen = i;
+    chosen_omega = omega;
+    chosen_begin = before;
+    if (target < before + omega) break;
+    before += omega;
+  }
+  if (!(chosen_omega > 0)) return std::nullopt;
+  PreparedSphericalTriangle triangle =
+      prepare_spherical_triangle(v[0] - x_, v[chosen + 1] - x_, v[chosen + 2] - x_);
+  if (!(triangle.solid_angle > 0)) return std::nullopt;
+  double local = std::clamp((target - chosen_begin) / chosen_omega, 0.0, 1.0);
+  Vec3 direction = sample_spherical_triangle(triangle, {local, u.y});
+  double distance = light_plane_height(*light_, x_) / -dot(light_->normal, direction);
   if (!(distance > 0) || !std::isfinite(distance)) return std::nullopt;
   return finish(x_ + distance * direction);
 }

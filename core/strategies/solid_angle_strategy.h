@@ -4,10 +4,13 @@
 //
 // - Rectangular quads (edges perpendicular to 1e-6 relative): Ureña, Fajardo & King 2013
 //   (core/math/spherical_rectangle.h); u.x picks the line along edge2, u.y the point on it.
-// - Other parallelograms and polygons: the triangle fan around vertex 0, a triangle chosen by its
-//   solid angle (van Oosterom & Strackee), then Arvo 1995's mapping inside it as computed by
-//   Peters 2021 Sec. 5 (core/math/spherical_triangle.h). The fan's solid angles are cached for up
-//   to 14 triangles and recomputed per sample beyond that (no heap allocation either way).
+// - Other parallelograms and polygons: Peters 2021 Sec. 5 (PetersSolidAngleStrategy,
+//   core/polygon/peters_sa_strategy.h): the triangle fan around vertex 0, a triangle chosen by its
+//   solid angle (van Oosterom & Strackee), then Peters' subtriangle construction of Arvo 1995's
+//   map, every triangle prepared once per shading point (no heap allocation). Polygons of more
+//   than kMaxPolygonVertices (16) vertices (the scene format allows 1024) use the same
+//   construction (core/polygon/solid_angle_polygon.h) with each triangle's solid angle
+//   recomputed per sample instead of stored.
 // - Disks: uniform sampling of the cone of directions bounding the disk (the cone tangent to the
 //   disk's bounding sphere, or the whole hemisphere towards the disk when the point is within the
 //   radius of the centre); a direction that misses the disk gives no sample. Every point of the
@@ -22,6 +25,7 @@
 #include <string_view>
 
 #include "core/math/spherical_rectangle.h"
+#include "core/polygon/peters_sa_strategy.h"
 #include "core/strategies/strategy.h"
 
 namespace penumbra {
@@ -39,22 +43,19 @@ class SolidAngleStrategy {
   // the strategy cannot sample.
   double sampled_solid_angle() const { return solid_angle_; }
 
-  static constexpr int kCachedFanTriangles = 14;
-
  private:
-  enum class Domain { None, Rectangle, Fan, Cone };
-  std::optional<LightPoint> sample_fan(const Vec2& u) const;
+  enum class Domain { None, Rectangle, Fan, LargeFan, Cone };
+  std::optional<LightPoint> sample_large_fan(const Vec2& u) const;
+  double large_fan_triangle(size_t i) const;
   std::optional<LightPoint> sample_cone(const Vec2& u) const;
   std::optional<LightPoint> finish(const Vec3& point) const;
-  double fan_triangle_solid_angle(size_t i) const;
 
   const Light* light_;
   Vec3 x_;
   Domain domain_ = Domain::None;
   double solid_angle_ = 0;
   SphericalRectangle rectangle_;
-  size_t fan_triangles_ = 0;
-  std::array<double, kCachedFanTriangles> fan_solid_angles_{};
+  std::optional<PetersSolidAngleStrategy> fan_;
   Frame cone_frame_;
   double cone_one_minus_cos_ = 0;
 };

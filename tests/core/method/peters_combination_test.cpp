@@ -226,6 +226,12 @@ TEST(PetersCombination, RefusesWhatItDoesNotDefineWithAClearError) {
     expect_refusal(polygon_scene, method, "one psa term and one ltc term");
   Scene disk_scene = scene_with(test::disk_light({0, 1, 0}, {0, -1, 0}, 0.3), test::lambert());
   expect_refusal(disk_scene, "psa+ltc/weighted", "disk");
+  // The polygon samplers keep fixed arrays of 16 vertices; the scene format allows more.
+  Scene many =
+      scene_with(test::regular_polygon_light({0, 1, 0}, {0, -1, 0}, 0.4, 20), test::lambert());
+  expect_refusal(many, "psa+ltc/clamped-optimal", "up to 16 vertices");
+  expect_refusal(many, "psa", "up to 16 vertices");
+  EXPECT_NO_THROW(DirectLighting(many, parse_method("sa")));
   // Accepted on quads and polygons.
   for (const Light& light : test_lights()) {
     Scene scene = scene_with(light, test::lambert());

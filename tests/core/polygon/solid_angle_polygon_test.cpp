@@ -56,7 +56,7 @@ TEST(SolidAnglePolygon, SolidAngleMatchesQuadrature) {
 
 TEST(SolidAnglePolygon, KnownSolidAngles) {
   // An octant: the spherical triangle of the three axes has solid angle 4 pi / 8.
-  EXPECT_NEAR(spherical_triangle_solid_angle({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2, 1e-15);
+  EXPECT_NEAR(triangle_solid_angle({1, 0, 0}, {0, 1, 0}, {0, 0, 1}), kPi / 2, 1e-15);
   // A square of side 2 at distance 1 subtends 2 pi / 3 (a cube face seen from the centre).
   std::vector<Vec3> face = {{-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
   EXPECT_NEAR(SolidAnglePolygonSampler(face).solid_angle(), 2 * kPi / 3, 1e-14);
@@ -91,7 +91,7 @@ TEST(SolidAnglePolygon, SubtriangleHasTheRequestedSolidAngle) {
     if (t.solid_angle < 1e-6) continue;
     double ux = uniform(rng);
     Vec3 end = sample_spherical_triangle(t, {ux, 1.0});
-    double sub = spherical_triangle_solid_angle(t.v0, t.v1, end);
+    double sub = triangle_solid_angle(t.v0, t.v1, end);
     EXPECT_NEAR(sub, ux * t.solid_angle, 1e-9 * (1 + t.solid_angle)) << k;
   }
 }
