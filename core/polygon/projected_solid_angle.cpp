@@ -322,7 +322,13 @@ double ProjectedSolidAngleSampler::area_up_to(const Sector& s, const Vec2& w) co
   double cr = cross2(s.s0, w);
   double xo = ellipse_form(o, s.s0, w), xi = ellipse_form(i, s.s0, w);
   double yo = co * cr, yi = ci * cr;
-  double c_difference = (dot2(i.m, i.m) - dot2(o.m, o.m)) / (co + ci);  // |c_o| - |c_i|
+  // |c_o| - |c_i|: directly where the ellipses are thin (great circles near the zenith, small
+  // |c|, where |m|^2 ~ 1 and the m form cancels), else from the m's (the form above); each is
+  // used where its rounding error, eps max(|c|) or eps max(|m|^2) / (|c_o| + |c_i|), is smaller.
+  double mi2 = dot2(i.m, i.m), mo2 = dot2(o.m, o.m);
+  double c_difference = std::max(co, ci) * (co + ci) < std::max(mi2, mo2)
+                            ? co - ci
+                            : (mi2 - mo2) / (co + ci);
   double mi = dot2(i.m, s.s0) * dot2(i.m, w), mo = dot2(o.m, s.s0) * dot2(o.m, w);
   // |c_o| x_i - |c_i| x_o, the factor of sin(alpha_o - alpha_i) besides cross(s0, w).
   double mixed = -co * ci * c_difference * dot2(s.s0, w) + co * mi - ci * mo;

@@ -44,23 +44,9 @@ TEST(Stability, NoMethodProducesNonFiniteEstimates) {
     }
 }
 
-// Known issue, measured: psa-based estimators (psa, ltc, and their combinations) are 0.47% high
-// where the shading point lies 1e-7 from the light's plane with the light on the great circle
-// through the zenith (sa, line-sa and line-bd16 agree with Lambert's closed form there to
-// 0.04%). Until the sector areas are computed stably there, these cells are held to 1%.
-bool known_psa_near_plane_issue(const StabilityCell& cell) {
-  return cell.case_name == "near-light-plane" &&
-         (cell.method == "psa" || cell.method == "ltc" || cell.method == "bsdf+psa" ||
-          cell.method.rfind("psa+ltc", 0) == 0);
-}
-
 TEST(Stability, EveryMethodIsConsistentWithTheReference) {
   for (const StabilityCell& cell : table().cells) {
     if (cell.refused || !cell.expected_unconverged.empty()) continue;
-    if (known_psa_near_plane_issue(cell)) {
-      EXPECT_LT(std::abs(cell.relative_bias), 0.01) << cell.method << " / " << cell.case_name;
-      continue;
-    }
     EXPECT_TRUE(cell.consistent) << cell.method << " / " << cell.case_name << ": mean " << cell.mean
                                  << ", reference " << cell.reference << ", relative bias "
                                  << cell.relative_bias << ", " << cell.bias_sigmas
