@@ -53,9 +53,11 @@ for scene in $scenes; do
   reference_log="${reference%.exr}.log"
   if [[ ! -f "$reference" ]]; then
     echo "rendering the reference of $scene (bsdf+sa, $reference_seconds s compute) ..." >&2
+    partial="${reference%.exr}-partial"
     "$penumbra" render "$scene_file" -m bsdf+sa --seconds "$reference_seconds" \
-      --threads "$threads" --seed 99 -o "$reference.tmp.exr" > "$reference_log"
-    mv "$reference.tmp.exr" "$reference"
+      --threads "$threads" --seed 99 -o "$partial.exr" > "$reference_log"
+    mv "$partial.png" "${reference%.exr}.png"
+    mv "$partial.exr" "$reference"
   fi
   reference_spp=$(grep -o '[0-9]* spp' "$reference_log" | head -1)
   rows=()
