@@ -12,6 +12,8 @@
 // machines drift by ~25% hour to hour; ratios in one run do not).
 //
 // Run: build-*/bench/line_query_bench [--benchmark_filter=S1] [--benchmark_repetitions=5]
+//      [--bundled]     (also every bundled scene with a quad light: shadow_ray and
+//                       line_query_medium on scene:<file stem>, e.g. --benchmark_filter=scene:)
 //      [--queries=N]   (a fixed number of iterations per benchmark: repeatable instruction
 //                       counts under callgrind, e.g.
 //   valgrind --tool=callgrind --toggle-collect='penumbra::LineQuery::visible_intervals*'
@@ -23,9 +25,11 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <random>
@@ -116,7 +120,25 @@ BenchScene with_random_triangles() {
   return scene;
 }
 
+// A bundled scene by file stem ("scene:<stem>"): its triangles, first quad light and camera.
+BenchScene bundled_scene(const std::string& stem) {
+  BenchScene scene;
+  scene.name = "scene:" + stem;
+  scene.description = "scenes/" + stem + ".json";
+  Scene loaded = load_scene(std::string(PENUMBRA_SOURCE_DIR) + "/" + scene.description);
+  for (const Light& light : loaded.lights) {
+    if (light.type != LightType::Quad) continue;
+    scene.mesh.positions = loaded.positions;
+    scene.mesh.indices = loaded.indices;
+    scene.light = {light.origin, light.edge1, light.edge2};
+    scene.camera = loaded.camera;
+    return scene;
+  }
+  throw std::runtime_error(scene.description + " has no quad light");
+}
+
 BenchScene make_scene(const std::string& name) {
+  if (name.rfind("scene:", 0) == 0) return bundled_scene(name.substr(6));
   if (name == "S3") return with_sphere();
   if (name == "S2") return with_random_triangles();
   return cornell_occluders();
@@ -231,16 +253,28 @@ struct Prepared {
 };
 
 std::unique_ptr<Prepared> current;
-Prepared& prepare(const std::string& name) {
+// The prepared scene, or null (with the benchmark skipped) when it does not load.
+Prepared* prepare(benchmark::State& state, const std::string& name) {
   if (!current || current->scene.name != name) {
     current.reset();  // one large scene in memory at a time
-    current = std::make_unique<Prepared>(name);
+    try {
+      current = std::make_unique<Prepared>(name);
+    } catch (const std::exception& error) {
+      state.SkipWithError(error.what());
+      return nullptr;
+    }
   }
-  return *current;
+  if (current->queries.empty()) {
+    state.SkipWithError("no shading point sees the light");
+    return nullptr;
+  }
+  return current.get();
 }
 
 void shadow_rays(benchmark::State& state, const std::string& name) {
-  Prepared& prepared = prepare(name);
+  Prepared* loaded = prepare(state, name);
+  if (!loaded) return;
+  Prepared& prepared = *loaded;
   const ShadowTriangleTolerances tolerances;
   size_t i = 0, occluded = 0, count = 0;
   for (auto _ : state) {
@@ -271,7 +305,9 @@ void shadow_rays(benchmark::State& state, const std::string& name) {
 }
 
 void line_queries(benchmark::State& state, const std::string& name, LineQueryBuildQuality quality) {
-  Prepared& prepared = prepare(name);
+  Prepared* loaded = prepare(state, name);
+  if (!loaded) return;
+  Prepared& prepared = *loaded;
   const LineQuery& line_query = prepared.line_query(quality);
   // Measure only a query that gives the right answer: a sample against the brute force.
   size_t checks = prepared.scene.mesh.triangle_count() > 100'000 ? 8 : 256;
@@ -318,6 +354,8 @@ void line_queries(benchmark::State& state, const std::string& name, LineQueryBui
 // Collects CPU time per query by benchmark name and prints the ratios at the end.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
+  std::vector<std::string> scenes;  // in the order of the summary
+
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
@@ -329,19 +367,19 @@ class RatioReporter : public benchmark::ConsoleReporter {
   }
   void print_summary() const {
     std::printf("\nPer query, one thread, CPU time (median when repeated):\n");
-    std::printf("%-6s %14s %18s %8s %18s %8s\n", "scene", "shadow ray ns", "line medium ns",
+    std::printf("%-24s %14s %18s %8s %18s %8s\n", "scene", "shadow ray ns", "line medium ns",
                 "ratio", "line high ns", "ratio");
-    for (const char* scene : {"S1", "S3", "S2"}) {
+    for (const std::string& scene : scenes) {
       auto find = [&](const std::string& key) {
         auto found = nanoseconds_.find(key);
         return found == nanoseconds_.end() ? -1.0 : found->second;
       };
-      double ray = find(std::string("shadow_ray/") + scene);
-      double medium = find(std::string("line_query_medium/") + scene);
-      double high = find(std::string("line_query_high/") + scene);
+      double ray = find("shadow_ray/" + scene);
+      double medium = find("line_query_medium/" + scene);
+      double high = find("line_query_high/" + scene);
       if (ray <= 0) continue;
-      std::printf("%-6s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene, ray, medium, medium / ray, high,
-                  high / ray);
+      std::printf("%-24s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene.c_str(), ray, medium,
+                  medium / ray, high, high / ray);
     }
   }
 
@@ -354,12 +392,19 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 int main(int argc, char** argv) {
   using namespace penumbra;
-  // --queries=N: fixed iterations (removed before Google Benchmark parses the rest).
+  // --queries=N: fixed iterations; --bundled: also every bundled scene with a quad light
+  // (line_query_medium only). Removed before Google Benchmark parses the rest.
   long fixed_iterations = 0;
+  bool bundled = false;
   for (int i = 1; i < argc; ++i) {
     std::string argument(argv[i]);
-    if (argument.rfind("--queries=", 0) != 0) continue;
-    fixed_iterations = std::stol(argument.substr(10));
+    if (argument == "--bundled") {
+      bundled = true;
+    } else if (argument.rfind("--queries=", 0) == 0) {
+      fixed_iterations = std::stol(argument.substr(10));
+    } else {
+      continue;
+    }
     for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
     --argc;
     --i;
@@ -371,8 +416,10 @@ int main(int argc, char** argv) {
   // Flush-to-zero and denormals-are-zero, as every render thread sets them.
   _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
   _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+  RatioReporter reporter;
   for (const char* scene : {"S1", "S3", "S2"}) {
     std::string name(scene);
+    reporter.scenes.push_back(name);
     fix(benchmark::RegisterBenchmark(
         (std::string("shadow_ray/") + name).c_str(),
         [name](benchmark::State& state) { shadow_rays(state, name); }));
@@ -385,9 +432,26 @@ int main(int argc, char** argv) {
                                        line_queries(state, name, LineQueryBuildQuality::High);
                                      }));
   }
+  if (bundled) {
+    std::vector<std::string> stems;
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::string(PENUMBRA_SOURCE_DIR) + "/scenes"))
+      if (entry.path().extension() == ".json") stems.push_back(entry.path().stem().string());
+    std::sort(stems.begin(), stems.end());
+    for (const std::string& stem : stems) {
+      std::string name = "scene:" + stem;
+      reporter.scenes.push_back(name);
+      fix(benchmark::RegisterBenchmark(
+          ("shadow_ray/" + name).c_str(),
+          [name](benchmark::State& state) { shadow_rays(state, name); }));
+      fix(benchmark::RegisterBenchmark(("line_query_medium/" + name).c_str(),
+                                       [name](benchmark::State& state) {
+                                         line_queries(state, name, LineQueryBuildQuality::Medium);
+                                       }));
+    }
+  }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   reporter.print_summary();
   benchmark::Shutdown();
