@@ -1,5 +1,12 @@
 #include "server/store.h"
 
+#include <fcntl.h>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <filesystem>
 #include <stdexcept>
 
@@ -31,9 +38,9 @@ CREATE TABLE IF NOT EXISTS curve (
 // A prepared statement with positional binding (1-based) and column access (0-based).
 class Store::Statement {
  public:
-  Statement(sqlite3* db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql, -1, &statement_, nullptr) != SQLITE_OK)
-      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db) + " in: " + sql);
+  Statement(Store& store, const char* sql) : store_(store) {
+    int code = sqlite3_prepare_v2(store.db_, sql, -1, &statement_, nullptr);
+    if (code != SQLITE_OK) store_.throw_error(code, sql);
   }
   ~Statement() { sqlite3_finalize(statement_); }
   Statement& bind(int index, int64_t value) {
@@ -57,7 +64,7 @@ class Store::Statement {
     int code = sqlite3_step(statement_);
     if (code == SQLITE_ROW) return true;
     if (code == SQLITE_DONE) return false;
-    throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db_));
+    store_.throw_error(code, sqlite3_sql(statement_));
   }
   void run() {
     while (step()) {
@@ -77,7 +84,7 @@ class Store::Statement {
   bool is_null(int column) { return sqlite3_column_type(statement_, column) == SQLITE_NULL; }
 
  private:
-  sqlite3* db_;
+  Store& store_;
   sqlite3_stmt* statement_ = nullptr;
 };
 
@@ -98,10 +105,12 @@ class Store::Transaction {
   bool committed_ = false;
 };
 
-Store::Store(const std::string& data_dir) {
+Store::Store(const std::string& data_dir, StoreOptions options)
+    : data_dir_(data_dir), options_(options) {
   std::error_code error;
   std::filesystem::create_directories(data_dir, error);
   path_ = (std::filesystem::path(data_dir) / "penumbra.sqlite").string();
+  reserve_path_ = (std::filesystem::path(data_dir) / "penumbra.reserve").string();
   if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
       SQLITE_OK) {
     std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
@@ -112,6 +121,10 @@ Store::Store(const std::string& data_dir) {
   execute("PRAGMA journal_mode=WAL");
   execute("PRAGMA synchronous=FULL");
   execute(kSchema);
+  std::lock_guard lock(reserve_mutex_);
+  if (!make_reserve())
+    spdlog::warn("store: no room for the {} byte reserve in {}: the disk is nearly full",
+                 options_.reserve_bytes, data_dir_);
 }
 
 Store::~Store() {
@@ -119,17 +132,90 @@ Store::~Store() {
 }
 
 void Store::execute(const char* sql) {
-  char* message = nullptr;
-  if (sqlite3_exec(db_, sql, nullptr, nullptr, &message) != SQLITE_OK) {
-    std::string text = message ? message : "unknown error";
-    sqlite3_free(message);
-    throw std::runtime_error("sqlite (" + path_ + "): " + text);
+  int code = sqlite3_exec(db_, sql, nullptr, nullptr, nullptr);
+  if (code != SQLITE_OK) throw_error(code, sql);
+}
+
+void Store::throw_error(int code, const std::string& context) {
+  std::string message = sqlite3_errmsg(db_);
+  int primary = code & 0xff;
+  int system_error = primary == SQLITE_IOERR ? sqlite3_system_errno(db_) : 0;
+  if (primary == SQLITE_FULL || system_error == ENOSPC || system_error == EDQUOT)
+    throw FarmError(FarmErrorCode::ResourceExhausted,
+                    "disk full: no space left on the coordinator's data disk (" + data_dir_ +
+                        "); sqlite: " + message);
+  std::string statement = context.substr(0, 120);
+  throw std::runtime_error("sqlite (" + path_ + "): " + message +
+                           (statement.empty() ? "" : " in: " + statement));
+}
+
+// Called with reserve_mutex_ held.
+bool Store::make_reserve() {
+  if (options_.reserve_bytes == 0) return true;
+  struct stat info {};
+  if (::stat(reserve_path_.c_str(), &info) == 0 && uint64_t(info.st_size) >= options_.reserve_bytes)
+    return true;
+  int fd = ::open(reserve_path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0600);
+  if (fd < 0) return false;
+  int error = ::posix_fallocate(fd, 0, off_t(options_.reserve_bytes));
+  ::close(fd);
+  if (error != 0) {
+    ::unlink(reserve_path_.c_str());
+    return false;
   }
+  spdlog::info("store: reserve of {} bytes in place ({})", options_.reserve_bytes, reserve_path_);
+  return true;
+}
+
+bool Store::spend_reserve() {
+  std::lock_guard lock(reserve_mutex_);
+  if (::unlink(reserve_path_.c_str()) != 0) return false;
+  spdlog::warn(
+      "store: the data disk is full; the reserve is released so that running jobs can "
+      "finish, and new jobs are refused until space returns");
+  return true;
+}
+
+bool Store::has_reserve() {
+  std::lock_guard lock(reserve_mutex_);
+  return options_.reserve_bytes == 0 || ::access(reserve_path_.c_str(), F_OK) == 0;
+}
+
+void Store::require_space_for_new_work(uint64_t bytes) {
+  std::lock_guard lock(reserve_mutex_);
+  bool reserve = make_reserve();
+  struct statvfs info {};
+  if (::statvfs(data_dir_.c_str(), &info) == 0) {
+    uint64_t free_bytes = uint64_t(info.f_bavail) * uint64_t(info.f_frsize);
+    if (free_bytes < options_.min_free_bytes + bytes)
+      throw FarmError(FarmErrorCode::ResourceExhausted,
+                      "disk full: " + std::to_string(free_bytes) +
+                          " bytes free on the coordinator's data disk (" + data_dir_ +
+                          "), new work needs " + std::to_string(options_.min_free_bytes + bytes) +
+                          "; no new jobs until space is freed");
+  }
+  if (!reserve)
+    throw FarmError(FarmErrorCode::ResourceExhausted,
+                    "disk full: no room for the " + std::to_string(options_.reserve_bytes) +
+                        " byte reserve on the coordinator's data disk (" + data_dir_ +
+                        "); no new jobs until space is freed");
+}
+
+template <typename Write>
+void Store::write_progress(Write&& write) {
+  try {
+    write();
+    return;
+  } catch (const FarmError& error) {
+    if (error.code() != FarmErrorCode::ResourceExhausted || !spend_reserve()) throw;
+  }
+  write();
 }
 
 void Store::put_scene(const std::string& hash, const std::string& package) {
+  require_space_for_new_work(package.size());
   std::lock_guard lock(mutex_);
-  Statement(db_, "INSERT OR IGNORE INTO scenes (hash, package) VALUES (?, ?)")
+  Statement(*this, "INSERT OR IGNORE INTO scenes (hash, package) VALUES (?, ?)")
       .bind_text(1, hash)
       .bind_blob(2, package)
       .run();
@@ -137,15 +223,16 @@ void Store::put_scene(const std::string& hash, const std::string& package) {
 
 std::optional<std::string> Store::scene(const std::string& hash) {
   std::lock_guard lock(mutex_);
-  Statement statement(db_, "SELECT package FROM scenes WHERE hash = ?");
+  Statement statement(*this, "SELECT package FROM scenes WHERE hash = ?");
   statement.bind_text(1, hash);
   if (!statement.step()) return std::nullopt;
   return statement.blob(0);
 }
 
 uint64_t Store::add_job(const JobRecord& job) {
+  require_space_for_new_work(job.spec.size());
   std::lock_guard lock(mutex_);
-  Statement(db_,
+  Statement(*this,
             "INSERT INTO jobs (spec, priority, state, error, submitted_ms, started_ms, "
             "finished_ms, blocks_opened, blocks_sealed, compute_seconds, final_errors) "
             "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)")
@@ -165,7 +252,7 @@ uint64_t Store::add_job(const JobRecord& job) {
 }
 
 void Store::write_job_fields(const JobRecord& job) {
-  Statement(db_,
+  Statement(*this,
             "UPDATE jobs SET state = ?, error = ?, started_ms = ?, finished_ms = ?, "
             "blocks_opened = ?, blocks_sealed = ?, compute_seconds = ?, final_errors = ? "
             "WHERE id = ?")
@@ -183,12 +270,12 @@ void Store::write_job_fields(const JobRecord& job) {
 
 void Store::update_job(const JobRecord& job) {
   std::lock_guard lock(mutex_);
-  write_job_fields(job);
+  write_progress([&] { write_job_fields(job); });
 }
 
 std::vector<JobRecord> Store::jobs() {
   std::lock_guard lock(mutex_);
-  Statement statement(db_,
+  Statement statement(*this,
                       "SELECT id, spec, priority, state, error, submitted_ms, started_ms, "
                       "finished_ms, blocks_opened, blocks_sealed, compute_seconds, final_errors "
                       "FROM jobs ORDER BY id");
@@ -230,19 +317,21 @@ void Store::add_task_result(uint64_t job_id, const TaskResultRecord& result) {
     std::exception_ptr error;
     try {
       std::lock_guard connection(mutex_);
-      Transaction transaction(*this);
-      Statement insert(db_,
-                       "INSERT OR REPLACE INTO task_results (job_id, task_index, tile, "
-                       "compute_seconds) VALUES (?, ?, ?, ?)");
-      for (const QueuedResult& queued : batch) {
-        insert.bind(1, int64_t(queued.job_id))
-            .bind(2, int64_t(queued.result.task_index))
-            .bind_blob(3, queued.result.tile)
-            .bind(4, queued.result.compute_seconds)
-            .run();
-        insert.reset();
-      }
-      transaction.commit();
+      write_progress([&] {
+        Transaction transaction(*this);
+        Statement insert(*this,
+                         "INSERT OR REPLACE INTO task_results (job_id, task_index, tile, "
+                         "compute_seconds) VALUES (?, ?, ?, ?)");
+        for (const QueuedResult& queued : batch) {
+          insert.bind(1, int64_t(queued.job_id))
+              .bind(2, int64_t(queued.result.task_index))
+              .bind_blob(3, queued.result.tile)
+              .bind(4, queued.result.compute_seconds)
+              .run();
+          insert.reset();
+        }
+        transaction.commit();
+      });
     } catch (...) {
       error = std::current_exception();
     }
@@ -262,7 +351,7 @@ void Store::add_task_result(uint64_t job_id, const TaskResultRecord& result) {
 
 std::vector<TaskResultRecord> Store::task_results(uint64_t job_id) {
   std::lock_guard lock(mutex_);
-  Statement statement(db_,
+  Statement statement(*this,
                       "SELECT task_index, tile, compute_seconds FROM task_results "
                       "WHERE job_id = ? ORDER BY task_index");
   statement.bind(1, int64_t(job_id));
@@ -276,38 +365,42 @@ void Store::seal_block(const JobRecord& job, const std::map<uint32_t, std::strin
                        uint64_t first_task, uint64_t end_task,
                        const std::optional<CurvePoint>& point) {
   std::lock_guard lock(mutex_);
-  Transaction transaction(*this);
-  {
-    Statement insert(db_,
-                     "INSERT OR REPLACE INTO tiles (job_id, tile_index, sums) VALUES (?, ?, ?)");
-    for (const auto& [tile_index, sums] : tiles) {
-      insert.bind(1, int64_t(job.id)).bind(2, int64_t(tile_index)).bind_blob(3, sums).run();
-      insert.reset();
+  write_progress([&] {
+    Transaction transaction(*this);
+    {
+      Statement insert(*this,
+                       "INSERT OR REPLACE INTO tiles (job_id, tile_index, sums) VALUES (?, ?, ?)");
+      for (const auto& [tile_index, sums] : tiles) {
+        insert.bind(1, int64_t(job.id)).bind(2, int64_t(tile_index)).bind_blob(3, sums).run();
+        insert.reset();
+      }
     }
-  }
-  Statement(db_, "DELETE FROM task_results WHERE job_id = ? AND task_index >= ? AND task_index < ?")
-      .bind(1, int64_t(job.id))
-      .bind(2, int64_t(first_task))
-      .bind(3, int64_t(end_task))
-      .run();
-  if (point) {
-    Statement(db_,
-              "INSERT OR REPLACE INTO curve (job_id, passes, compute_seconds, wall_seconds, mrse) "
-              "VALUES (?, ?, ?, ?, ?)")
+    Statement(*this,
+              "DELETE FROM task_results WHERE job_id = ? AND task_index >= ? AND task_index < ?")
         .bind(1, int64_t(job.id))
-        .bind(2, int64_t(point->passes))
-        .bind(3, point->compute_seconds)
-        .bind(4, point->wall_seconds)
-        .bind(5, point->mrse)
+        .bind(2, int64_t(first_task))
+        .bind(3, int64_t(end_task))
         .run();
-  }
-  write_job_fields(job);
-  transaction.commit();
+    if (point) {
+      Statement(
+          *this,
+          "INSERT OR REPLACE INTO curve (job_id, passes, compute_seconds, wall_seconds, mrse) "
+          "VALUES (?, ?, ?, ?, ?)")
+          .bind(1, int64_t(job.id))
+          .bind(2, int64_t(point->passes))
+          .bind(3, point->compute_seconds)
+          .bind(4, point->wall_seconds)
+          .bind(5, point->mrse)
+          .run();
+    }
+    write_job_fields(job);
+    transaction.commit();
+  });
 }
 
 std::map<uint32_t, std::string> Store::tiles(uint64_t job_id) {
   std::lock_guard lock(mutex_);
-  Statement statement(db_, "SELECT tile_index, sums FROM tiles WHERE job_id = ?");
+  Statement statement(*this, "SELECT tile_index, sums FROM tiles WHERE job_id = ?");
   statement.bind(1, int64_t(job_id));
   std::map<uint32_t, std::string> tiles;
   while (statement.step()) tiles[uint32_t(statement.integer(0))] = statement.blob(1);
@@ -316,7 +409,7 @@ std::map<uint32_t, std::string> Store::tiles(uint64_t job_id) {
 
 std::vector<CurvePoint> Store::curve(uint64_t job_id) {
   std::lock_guard lock(mutex_);
-  Statement statement(db_,
+  Statement statement(*this,
                       "SELECT passes, compute_seconds, wall_seconds, mrse FROM curve "
                       "WHERE job_id = ? ORDER BY passes");
   statement.bind(1, int64_t(job_id));
@@ -329,18 +422,20 @@ std::vector<CurvePoint> Store::curve(uint64_t job_id) {
 
 void Store::finish_job(const JobRecord& job, const std::string& exr) {
   std::lock_guard lock(mutex_);
-  Transaction transaction(*this);
-  Statement(db_, "UPDATE jobs SET result = ? WHERE id = ?")
-      .bind_blob(1, exr)
-      .bind(2, int64_t(job.id))
-      .run();
-  write_job_fields(job);
-  transaction.commit();
+  write_progress([&] {
+    Transaction transaction(*this);
+    Statement(*this, "UPDATE jobs SET result = ? WHERE id = ?")
+        .bind_blob(1, exr)
+        .bind(2, int64_t(job.id))
+        .run();
+    write_job_fields(job);
+    transaction.commit();
+  });
 }
 
 std::optional<std::string> Store::result(uint64_t job_id) {
   std::lock_guard lock(mutex_);
-  Statement statement(db_, "SELECT result FROM jobs WHERE id = ?");
+  Statement statement(*this, "SELECT result FROM jobs WHERE id = ?");
   statement.bind(1, int64_t(job_id));
   if (!statement.step() || statement.is_null(0)) return std::nullopt;
   return statement.blob(0);
@@ -348,11 +443,13 @@ std::optional<std::string> Store::result(uint64_t job_id) {
 
 void Store::drop_work(const JobRecord& job) {
   std::lock_guard lock(mutex_);
-  Transaction transaction(*this);
-  Statement(db_, "DELETE FROM task_results WHERE job_id = ?").bind(1, int64_t(job.id)).run();
-  Statement(db_, "DELETE FROM tiles WHERE job_id = ?").bind(1, int64_t(job.id)).run();
-  write_job_fields(job);
-  transaction.commit();
+  write_progress([&] {
+    Transaction transaction(*this);
+    Statement(*this, "DELETE FROM task_results WHERE job_id = ?").bind(1, int64_t(job.id)).run();
+    Statement(*this, "DELETE FROM tiles WHERE job_id = ?").bind(1, int64_t(job.id)).run();
+    write_job_fields(job);
+    transaction.commit();
+  });
 }
 
 }  // namespace penumbra::farm

@@ -4,6 +4,15 @@
 // error-versus-time curve and result EXRs. Every write commits before it returns, so whatever a
 // caller acknowledges after a write survives a crash of the process or the machine.
 //
+// A full disk: every write that fails for lack of space (SQLITE_FULL, ENOSPC) throws
+// FarmError(ResourceExhausted, "disk full: ...") and leaves the database as it was (the
+// transaction rolls back). So that running jobs can still finish when the disk fills, the store
+// keeps a reserve file (data_dir/penumbra.reserve, StoreOptions::reserve_bytes): a write that
+// records progress (task results, sealed blocks, finished jobs, job fields) and finds the disk
+// full deletes the reserve and tries again once. New work (scenes, jobs) is refused with
+// "disk full" while the data disk has less than StoreOptions::min_free_bytes free or the reserve
+// cannot be made again; once space returns, the reserve is remade and new work is accepted.
+//
 // The store knows no protobuf and no gRPC: a job's specification is opaque bytes to it.
 
 #include <sqlite3.h>
@@ -16,6 +25,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "server/farm_error.h"
 
 namespace penumbra::farm {
 
@@ -47,11 +58,16 @@ struct CurvePoint {
   double mrse = 0;
 };
 
+struct StoreOptions {
+  uint64_t reserve_bytes = uint64_t(8) << 20;   // space kept back for progress when the disk fills
+  uint64_t min_free_bytes = uint64_t(1) << 20;  // new work needs this much free (plus its size)
+};
+
 class Store {
  public:
   // Opens (creating when needed) data_dir/penumbra.sqlite. Throws std::runtime_error naming the
   // file when it cannot.
-  explicit Store(const std::string& data_dir);
+  explicit Store(const std::string& data_dir, StoreOptions options = {});
   ~Store();
   Store(const Store&) = delete;
   Store& operator=(const Store&) = delete;
@@ -85,11 +101,26 @@ class Store {
   // Drops what a finished, failed or cancelled job no longer needs (tile sums, task results).
   void drop_work(const JobRecord& job);
 
+  // True while the reserve file exists (false after a full disk used it up, until remade).
+  bool has_reserve();
+
  private:
   class Statement;
   class Transaction;
   void execute(const char* sql);
   void write_job_fields(const JobRecord& job);
+  // Throws FarmError(ResourceExhausted, "disk full: ...") when the last failure of the
+  // connection was a lack of space, std::runtime_error otherwise.
+  [[noreturn]] void throw_error(int code, const std::string& context);
+  // New work: refuses with "disk full" unless `bytes` more fit with room to spare and the
+  // reserve exists (remaking it when space allows).
+  void require_space_for_new_work(uint64_t bytes);
+  // Progress: runs `write` (a whole transaction); on a full disk, spends the reserve and runs
+  // it once more.
+  template <typename Write>
+  void write_progress(Write&& write);
+  bool make_reserve();
+  bool spend_reserve();
 
   struct QueuedResult {
     uint64_t job_id;
@@ -110,6 +141,10 @@ class Store {
   std::vector<FailedBatch> group_failures_;
   sqlite3* db_ = nullptr;
   std::string path_;
+  std::string data_dir_;
+  std::string reserve_path_;
+  StoreOptions options_;
+  std::mutex reserve_mutex_;
 };
 
 }  // namespace penumbra::farm

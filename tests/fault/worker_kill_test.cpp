@@ -1,0 +1,93 @@
+// Fault: workers SIGKILLed at random moments while jobs run, each restarted at once (at least 24
+// kills of workers holding leases in a run). Every job must finish, bit-identical to a local
+// render, and no task may be counted twice: the coordinator accepts exactly one result per task.
+// Built only with the farm (PENUMBRA_FARM=ON); otherwise the program reports a skipped test.
+#if __has_include("penumbra/v1/farm.pb.h")
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fault_support.h"
+
+namespace penumbra::farm::fault {
+namespace {
+
+[[maybe_unused]] auto* const table = ::testing::AddGlobalTestEnvironment(new FaultTableEnvironment);
+
+TEST(FaultWorkerKill, RandomKillsAndRestartsLoseNothing) {
+  // Plain processes on loopback: no root needed.
+  auto dir = testing::fresh_directory("fault-worker-kill");
+  std::string scene = testing::write_scene(dir, 64, 64);
+  InProcessCoordinator coordinator(dir / "data", 1000ms);
+  const int worker_count = 5;
+  std::vector<std::unique_ptr<testing::ChildProcess>> workers;
+  for (int w = 0; w < worker_count; ++w)
+    workers.push_back(testing::start_worker(coordinator.address(), dir, "w" + std::to_string(w)));
+
+  FarmClient client(coordinator.address());
+  std::vector<SubmittedJob> jobs;
+  uint64_t tasks_total = 0;
+  auto submit = [&] {
+    SubmittedJob job{"", "sa", 64, 1000 + jobs.size()};
+    // 16x16 tiles, 4 passes per task: 16 tiles x 16 blocks = 256 short tasks.
+    job.id = client.submit(testing::job_spec(scene, job.method, job.spp, job.seed, 16, 4)).job_id();
+    jobs.push_back(job);
+    tasks_total += 256;
+  };
+  for (int j = 0; j < 3; ++j) submit();
+
+  std::mt19937 random(20261123);
+  std::uniform_int_distribution<int> pause_ms(20, 150);
+  std::vector<std::string> names;
+  for (int w = 0; w < worker_count; ++w) names.push_back("w" + std::to_string(w));
+  const int wanted_kills = 24;
+  int kills = 0;
+  auto start = Clock::now();
+  auto last_kill = start;
+  while (kills < wanted_kills) {
+    ASSERT_LT(seconds_since(start), 45.0) << "the kills took too long";
+    std::this_thread::sleep_for(std::chrono::milliseconds(pause_ms(random)));
+    // Keep work queued so that the workers stay busy.
+    if (coordinator.coordinator().counters().queued_tasks < 64 && jobs.size() < 12) submit();
+    // The victim: a random worker among those holding leases now.
+    std::vector<size_t> holding;
+    for (size_t w = 0; w < workers.size(); ++w)
+      if (coordinator.leased_by(names[w]) > 0) holding.push_back(w);
+    // When none holds one (all starting up on a loaded machine), any worker.
+    if (holding.empty()) {
+      if (Clock::now() - last_kill < 300ms) continue;
+      for (size_t v = 0; v < workers.size(); ++v) holding.push_back(v);
+    }
+    size_t w = holding[std::uniform_int_distribution<size_t>(0, holding.size() - 1)(random)];
+    last_kill = Clock::now();
+    workers[w]->signal(SIGKILL);
+    workers[w]->wait_exit(10s);
+    ++kills;
+    names[w] = "w" + std::to_string(w) + "-" + std::to_string(kills);
+    workers[w] = testing::start_worker(coordinator.address(), dir, names[w]);
+  }
+  std::printf("%d kills in %.1f s, %zu jobs\n", kills, seconds_since(start), jobs.size());
+
+  FaultRow row{"worker SIGKILL + restart", kills};
+  check_jobs(coordinator.address(), scene, jobs, row);
+  CoordinatorCounters counters = coordinator.coordinator().counters();
+  std::printf(
+      "tasks leased %llu, completed %llu, leases expired %llu, late results %llu\n",
+      (unsigned long long)counters.tasks_leased, (unsigned long long)counters.tasks_completed,
+      (unsigned long long)counters.leases_expired, (unsigned long long)counters.late_results);
+  EXPECT_EQ(counters.tasks_completed, tasks_total) << "a task was accepted twice or never";
+  EXPECT_EQ(coordinator.completed_by_all(), tasks_total);
+  EXPECT_GT(counters.leases_expired, 0u) << "no lease of a killed worker expired";
+  record_fault_row(row);
+  EXPECT_EQ(row.lost_jobs, 0);
+  EXPECT_EQ(row.mismatched_images, 0);
+}
+
+}  // namespace
+}  // namespace penumbra::farm::fault
+#else
+#include <gtest/gtest.h>
+TEST(FarmNotBuilt, Skipped) {
+  GTEST_SKIP() << "configured with PENUMBRA_FARM=OFF";
+}
+#endif
