@@ -23,10 +23,8 @@ double polygon_solid_angle(std::span<const Vec3> vertices) {
   return total;
 }
 
-namespace {
-
-// Unit vertices and Peters' G0, G1, G2 (Sec. 5), oriented so that G0 >= 0; solid_angle unset.
-PreparedSphericalTriangle prepare_intermediates(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+PreparedSphericalTriangle prepare_spherical_triangle(const Vec3& p0, const Vec3& p1,
+                                                     const Vec3& p2) {
   PreparedSphericalTriangle t;
   double l0 = length(p0), l1 = length(p1), l2 = length(p2);
   if (!(l0 > 0 && l1 > 0 && l2 > 0) || !std::isfinite(l0 * l1 * l2)) return t;
@@ -35,33 +33,16 @@ PreparedSphericalTriangle prepare_intermediates(const Vec3& p0, const Vec3& p1, 
   t.v2 = p2 / l2;
   t.g0 = triple_product_from_edges(p0, p1, p2) / (l0 * l1 * l2);
   // Orient the triangle so that its determinant is non-negative: the subtriangle construction
-  // assumes counter-clockwise vertices as seen from outside the sphere.
+  // below assumes counter-clockwise vertices as seen from outside the sphere.
   if (t.g0 < 0) {
     std::swap(t.v1, t.v2);
     t.g0 = -t.g0;
   }
   t.g1 = dot(t.v0, t.v2) + dot(t.v1, t.v2);
   t.g2 = 1.0 + dot(t.v0, t.v1);
-  return t;
-}
-
-}  // namespace
-
-PreparedSphericalTriangle prepare_spherical_triangle(const Vec3& p0, const Vec3& p1,
-                                                     const Vec3& p2) {
-  PreparedSphericalTriangle t = prepare_intermediates(p0, p1, p2);
   // Peters Eq. 13.
   t.solid_angle = 2.0 * std::atan2(t.g0, t.g2 + t.g1);
   if (!std::isfinite(t.solid_angle) || t.solid_angle < 0) t.solid_angle = 0;
-  return t;
-}
-
-PreparedSphericalTriangle prepare_spherical_triangle(const Vec3& p0, const Vec3& p1, const Vec3& p2,
-                                                     double known_solid_angle) {
-  PreparedSphericalTriangle t = prepare_intermediates(p0, p1, p2);
-  t.solid_angle = std::isfinite(known_solid_angle) && known_solid_angle > 0 && t.g0 > 0
-                      ? known_solid_angle
-                      : 0.0;
   return t;
 }
 
@@ -100,37 +81,36 @@ Vec3 sample_spherical_triangle(const PreparedSphericalTriangle& triangle, const 
 SolidAnglePolygonSampler::SolidAnglePolygonSampler(std::span<const Vec3> vertices) {
   int n = static_cast<int>(vertices.size());
   if (n < 3 || n > kMaxPolygonVertices) return;
-  vertex_count_ = n;
-  std::copy(vertices.begin(), vertices.end(), vertices_.begin());
-  // Triangle fan around vertex 0 (Peters Fig. 11a), van Oosterom & Strackee per triangle.
-  for (int i = 0; i + 2 < n; ++i) {
-    solid_angles_[i] = triangle_solid_angle(vertices_[0], vertices_[i + 1], vertices_[i + 2]);
-    solid_angle_ += solid_angles_[i];
+  // Triangle fan around vertex 0 (Peters Fig. 11a); degenerate triangles are dropped.
+  for (int i = 1; i + 1 < n; ++i) {
+    PreparedSphericalTriangle t =
+        prepare_spherical_triangle(vertices[0], vertices[i], vertices[i + 1]);
+    if (t.solid_angle > 0) {
+      triangles_[triangle_count_++] = t;
+      solid_angle_ += t.solid_angle;
+    }
   }
   if (!(solid_angle_ > 0) || !std::isfinite(solid_angle_)) {
     solid_angle_ = 0;
-    vertex_count_ = 0;
+    triangle_count_ = 0;
   }
 }
 
 std::optional<Vec3> SolidAnglePolygonSampler::sample(const Vec2& u) const {
-  // Choose a fan triangle in proportion to its solid angle and reuse u.x inside it; rounding
-  // leftovers (target >= the sum) go to the last triangle with a solid angle.
-  double target = u.x * solid_angle_, before = 0, chosen_begin = 0;
-  int chosen = -1;
-  for (int i = 0; i + 2 < vertex_count_; ++i) {
-    double omega = solid_angles_[i];
-    if (!(omega > 0)) continue;
-    chosen = i;
-    chosen_begin = before;
-    if (target < before + omega) break;
-    before += omega;
+  if (triangle_count_ == 0) return std::nullopt;
+  // Choose a fan triangle in proportion to its solid angle and reuse u.x inside it.
+  double target = u.x * solid_angle_;
+  int chosen = triangle_count_ - 1;
+  double before = 0;
+  for (int i = 0; i < triangle_count_; ++i) {
+    if (target < before + triangles_[i].solid_angle || i == triangle_count_ - 1) {
+      chosen = i;
+      break;
+    }
+    before += triangles_[i].solid_angle;
   }
-  if (chosen < 0) return std::nullopt;
-  PreparedSphericalTriangle t = prepare_spherical_triangle(
-      vertices_[0], vertices_[chosen + 1], vertices_[chosen + 2], solid_angles_[chosen]);
-  if (!(t.solid_angle > 0)) return std::nullopt;
-  double local = std::clamp((target - chosen_begin) / t.solid_angle, 0.0, 1.0);
+  const PreparedSphericalTriangle& t = triangles_[chosen];
+  double local = std::clamp((target - before) / t.solid_angle, 0.0, 1.0);
   Vec3 direction = sample_spherical_triangle(t, {local, u.y});
   if (!is_finite(direction)) return std::nullopt;
   return direction;

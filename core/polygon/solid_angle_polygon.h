@@ -38,20 +38,12 @@ struct PreparedSphericalTriangle {
 // Prepares the triangle spanned by the (not necessarily normalized) directions p0, p1, p2.
 PreparedSphericalTriangle prepare_spherical_triangle(const Vec3& p0, const Vec3& p1,
                                                      const Vec3& p2);
-// The same when its solid angle is already known (triangle_solid_angle(p0, p1, p2), cached per
-// shading point by SolidAnglePolygonSampler): skips the arctangent.
-PreparedSphericalTriangle prepare_spherical_triangle(const Vec3& p0, const Vec3& p1, const Vec3& p2,
-                                                     double known_solid_angle);
 
 // Maps u in [0,1)^2 to a unit direction in the triangle, uniformly in solid angle: u.x picks the
 // subtriangle's solid angle, u.y the point on its arc v1 v2'.
 Vec3 sample_spherical_triangle(const PreparedSphericalTriangle& triangle, const Vec2& u);
 
-// A convex polygon prepared once per shading point for solid angle sampling. Preparation keeps
-// the vertices and each fan triangle's solid angle (one arctangent each); a sample prepares only
-// the triangle it falls in. Measured (bench/polygon_bench.cpp): this lazy form is ~1.3-1.4x
-// cheaper per shading point than preparing every triangle up front and ~1.3x dearer per extra
-// sample; the estimator draws 1-4 samples per term and pass, where it wins.
+// A convex polygon prepared once per shading point for solid angle sampling.
 class SolidAnglePolygonSampler {
  public:
   // `vertices`: the polygon's vertices relative to the shading point (any orientation, any
@@ -66,9 +58,8 @@ class SolidAnglePolygonSampler {
   std::optional<Vec3> sample(const Vec2& u) const;
 
  private:
-  int vertex_count_ = 0;
-  std::array<Vec3, kMaxPolygonVertices> vertices_;
-  std::array<double, kMaxPolygonVertices - 2> solid_angles_;  // of the fan triangles
+  int triangle_count_ = 0;
+  std::array<PreparedSphericalTriangle, kMaxPolygonVertices - 2> triangles_{};
   double solid_angle_ = 0;
 };
 

@@ -41,9 +41,11 @@ SolidAngleStrategy::SolidAngleStrategy(const ShadingPoint& sp, const Light& ligh
     }
     solid_angle_ = 2.0 * kPi * cone_one_minus_cos_;
     domain_ = Domain::Cone;
-  } else if (is_polygon_light(light)) {
+  } else if (light.vertices.size() >= 3 && light.vertices.size() <= size_t(kMaxPolygonVertices)) {
     // Quads that are not rectangles, and polygons: Peters' triangle fan.
-    fan_.emplace(sp, light);
+    std::array<Vec3, kMaxPolygonVertices> relative;
+    for (size_t i = 0; i < light.vertices.size(); ++i) relative[i] = light.vertices[i] - x_;
+    fan_.emplace(std::span<const Vec3>(relative.data(), light.vertices.size()));
     solid_angle_ = fan_->solid_angle();
     domain_ = Domain::Fan;
   } else if (light.vertices.size() >= 3) {
@@ -64,8 +66,10 @@ std::optional<LightPoint> SolidAngleStrategy::sample(const Vec2& u_in) const {
       return std::nullopt;
     case Domain::Rectangle:
       return finish(rectangle_.sample(u));
-    case Domain::Fan:
-      return fan_->sample(u);
+    case Domain::Fan: {
+      std::optional<Vec3> direction = fan_->sample(u);
+      return direction ? along(*direction) : std::nullopt;
+    }
     case Domain::LargeFan:
       return sample_large_fan(u);
     case Domain::Cone:
@@ -98,7 +102,10 @@ std::optional<LightPoint> SolidAngleStrategy::sample_large_fan(const Vec2& u) co
       prepare_spherical_triangle(v[0] - x_, v[chosen + 1] - x_, v[chosen + 2] - x_);
   if (!(triangle.solid_angle > 0)) return std::nullopt;
   double local = std::clamp((target - chosen_begin) / chosen_omega, 0.0, 1.0);
-  Vec3 direction = sample_spherical_triangle(triangle, {local, u.y});
+  return along(sample_spherical_triangle(triangle, {local, u.y}));
+}
+
+std::optional<LightPoint> SolidAngleStrategy::along(const Vec3& direction) const {
   double distance = light_plane_height(*light_, x_) / -dot(light_->normal, direction);
   if (!(distance > 0) || !std::isfinite(distance)) return std::nullopt;
   return finish(x_ + distance * direction);

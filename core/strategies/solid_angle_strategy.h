@@ -4,12 +4,12 @@
 //
 // - Rectangular quads (edges perpendicular to 1e-6 relative): Ureña, Fajardo & King 2013
 //   (core/math/spherical_rectangle.h); u.x picks the line along edge2, u.y the point on it.
-// - Other parallelograms and polygons: Peters 2021 Sec. 5 (PetersSolidAngleStrategy,
-//   core/polygon/peters_sa_strategy.h): the triangle fan around vertex 0, a triangle chosen by its
-//   solid angle (van Oosterom & Strackee), then Peters' subtriangle construction of Arvo 1995's
-//   map, every triangle prepared once per shading point (no heap allocation). Polygons of more
-//   than kMaxPolygonVertices (16) vertices (the scene format allows 1024) use the same
-//   construction (core/polygon/solid_angle_polygon.h) with each triangle's solid angle
+// - Other parallelograms and polygons: Peters 2021 Sec. 5 (SolidAnglePolygonSampler,
+//   core/polygon/solid_angle_polygon.h, which is also PetersSolidAngleStrategy's): the triangle
+//   fan around vertex 0, a triangle chosen by its solid angle (van Oosterom & Strackee), then
+//   Peters' subtriangle construction of Arvo 1995's map; every fan triangle is prepared once per
+//   shading point (no heap allocation). Polygons of more than kMaxPolygonVertices (16) vertices
+//   (the scene format allows 1024) use the same construction with each triangle's solid angle
 //   recomputed per sample instead of stored.
 // - Disks: uniform sampling of the cone of directions bounding the disk (the cone tangent to the
 //   disk's bounding sphere, or the whole hemisphere towards the disk when the point is within the
@@ -25,7 +25,7 @@
 #include <string_view>
 
 #include "core/math/spherical_rectangle.h"
-#include "core/polygon/peters_sa_strategy.h"
+#include "core/polygon/solid_angle_polygon.h"
 #include "core/strategies/strategy.h"
 
 namespace penumbra {
@@ -49,13 +49,15 @@ class SolidAngleStrategy {
   double large_fan_triangle(size_t i) const;
   std::optional<LightPoint> sample_cone(const Vec2& u) const;
   std::optional<LightPoint> finish(const Vec3& point) const;
+  // The point where the direction from x meets the light's plane, as a sample.
+  std::optional<LightPoint> along(const Vec3& direction) const;
 
   const Light* light_;
   Vec3 x_;
   Domain domain_ = Domain::None;
   double solid_angle_ = 0;
   SphericalRectangle rectangle_;
-  std::optional<PetersSolidAngleStrategy> fan_;
+  std::optional<SolidAnglePolygonSampler> fan_;
   Frame cone_frame_;
   double cone_one_minus_cos_ = 0;
 };
