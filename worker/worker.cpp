@@ -27,10 +27,12 @@ std::unique_ptr<grpc::ClientContext> context_with_deadline(std::chrono::seconds 
   return context;
 }
 
-bool is_hex_hash(const std::string& text) {
-  return !text.empty() && text.size() <= 128 && std::all_of(text.begin(), text.end(), [](char c) {
-    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
-  });
+// A scene content hash as core computes it: SHA-256 as 64 lowercase hex digits. Cache files are
+// named by it, so nothing else (no "../", no "/", no upper case, no other length) is accepted.
+bool is_content_hash(const std::string& text) {
+  return text.size() == 64 && std::all_of(text.begin(), text.end(), [](char c) {
+           return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+         });
 }
 
 std::string describe(const grpc::Status& status) {
@@ -308,7 +310,9 @@ std::shared_ptr<const Scene> RenderWorker::scene_for(const std::string& hash) {
     auto it = scenes_.find(hash);
     if (it != scenes_.end()) return it->second;
   }
-  if (!is_hex_hash(hash)) throw std::runtime_error("scene hash \"" + hash + "\" is not hex");
+  if (!is_content_hash(hash))
+    throw std::runtime_error("scene hash \"" + hash +
+                             "\" is not a content hash (64 lowercase hex)");
   v1::ScenePackage package;
   bool have_package = false;
   std::filesystem::path cached;
