@@ -378,8 +378,13 @@ class RatioReporter : public benchmark::ConsoleReporter {
       double medium = find("line_query_medium/" + scene);
       double high = find("line_query_high/" + scene);
       if (ray <= 0) continue;
-      std::printf("%-24s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene.c_str(), ray, medium,
-                  medium / ray, high, high / ray);
+      if (high > 0) {
+        std::printf("%-24s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene.c_str(), ray, medium,
+                    medium / ray, high, high / ray);
+      } else {
+        std::printf("%-24s %14.1f %18.1f %8.2f %18s %8s\n", scene.c_str(), ray, medium,
+                    medium / ray, "-", "-");
+      }
     }
   }
 
