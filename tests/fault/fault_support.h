@@ -43,7 +43,7 @@ inline double seconds_since(Clock::time_point start) {
 
 // Runs a shell command; returns its exit status (0: success).
 inline int shell(const std::string& command) {
-  int status = std::system((command + " >/dev/null 2>&1").c_str());
+  int status = std::system(("( " + command + " ) >/dev/null 2>&1").c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
@@ -522,17 +522,19 @@ inline double udp_echo_fraction(NetNamespace& ns, int count) {
   ns.run_inside([&] {
     int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     sockaddr_in target = socket_address(ns.host_ip(), port);
+    // Answers are read as they come (a socket buffer full of unread answers would drop some).
+    auto drain = [&](int timeout_ms) {
+      pollfd p{fd, POLLIN, 0};
+      if (::poll(&p, 1, timeout_ms) <= 0) return;
+      int value = 0;
+      while (::recv(fd, &value, sizeof value, MSG_DONTWAIT) > 0) ++answered;
+    };
     for (int i = 0; i < count; ++i) {
       ::sendto(fd, &i, sizeof i, 0, reinterpret_cast<sockaddr*>(&target), sizeof target);
-      std::this_thread::sleep_for(1ms);
+      drain(1);
     }
     auto deadline = Clock::now() + 1s;
-    while (Clock::now() < deadline) {
-      pollfd p{fd, POLLIN, 0};
-      if (::poll(&p, 1, 50) <= 0) continue;
-      int value = 0;
-      if (::recv(fd, &value, sizeof value, 0) > 0) ++answered;
-    }
+    while (Clock::now() < deadline) drain(50);
     ::close(fd);
   });
   stop = true;
