@@ -88,6 +88,31 @@ TEST_F(FarmTls, JobCompletesOverTlsWithTokens) {
   EXPECT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(bytes, std::string("\x08\x01", 2));
 
+  // The command-line client: --tls-ca with a token file works; without a token it is refused.
+  auto token_file = *dir_ / "alice.token";
+  std::ofstream(token_file) << testing::kAliceToken << "\n";
+  auto run_client = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> arguments = {testing::binary("client/penumbra"),
+                                          "list",
+                                          "--coordinator",
+                                          coordinator.address(),
+                                          "--tls-ca",
+                                          certificates_->ca.string()};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    auto log = *dir_ / (name + ".log");
+    testing::ChildProcess process(arguments, log.string());
+    int code = process.wait_exit(60s);
+    std::ifstream in(log);
+    return std::make_pair(
+        code, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  };
+  auto [listed, list_output] = run_client("client-list", {"--token-file", token_file.string()});
+  EXPECT_EQ(listed, 0) << list_output;
+  EXPECT_NE(list_output.find(job), std::string::npos) << list_output;
+  auto [refused, refused_output] = run_client("client-refused", {});
+  EXPECT_NE(refused, 0) << refused_output;
+  EXPECT_NE(refused_output.find("UNAUTHENTICATED"), std::string::npos) << refused_output;
+
   // A plaintext client cannot talk to the TLS coordinator.
   FarmClient plaintext(connection_to(coordinator.address(), testing::kAliceToken));
   EXPECT_EQ(code_of([&] { plaintext.list(); }), StatusCode::UNAVAILABLE);
