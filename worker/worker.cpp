@@ -14,6 +14,7 @@
 #include "penumbra/version.h"
 #include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
+#include "worker/task_decoding.h"
 
 namespace penumbra::farm {
 
@@ -273,12 +274,16 @@ void RenderWorker::render_loop() {
     }
     Outgoing outgoing;
     try {
+      // Fields first (the scene hash names a cache file), then against the scene: the tile
+      // inside the image, the pass range not empty (worker/task_decoding.h).
+      check_task_fields(task);
+      DecodedTask decoded = decode_task(task, *scene_for(task.scene_hash()));
       std::shared_ptr<const Renderer> renderer = renderer_for(task);
-      TileRect rect{task.tile().x0(), task.tile().y0(), task.tile().x1(), task.tile().y1()};
+      const TileRect rect = decoded.tile;
       TileAccumulator accumulator(rect);
       double cpu_start = process_cpu_seconds();
       arena.execute(
-          [&] { renderer->render_tile(rect, task.pass_begin(), task.pass_end(), accumulator); });
+          [&] { renderer->render_tile(rect, decoded.pass_begin, decoded.pass_end, accumulator); });
       v1::CompleteTaskRequest completion;
       completion.set_job_id(task.job_id());
       completion.set_task_index(task.task_index());

@@ -3,8 +3,9 @@
 // scene's folder, or a file missing from the package is refused even when the file exists on the
 // coordinator's disk). The worker's scene cache is addressed by content hash only: a task whose
 // scene hash is a path, not lowercase hex, or names a scene whose content hashes differently is
-// refused (FailTask) without fetching or writing anything outside its cache, and a good scene is
-// cached under its hash. The worker runs against a fake coordinator in this process.
+// refused (FailTask) without fetching or writing anything outside its cache, a task whose tile
+// leaves the image is refused, and a good scene is cached under its hash. The worker runs against a
+// fake coordinator in this process.
 #if __has_include("penumbra/v1/farm.pb.h")
 #include <grpcpp/server.h>
 #include <grpcpp/server_builder.h>
@@ -157,9 +158,15 @@ TEST(WorkerCache, AddressedByContentHashOnly) {
       "../../../../../../tmp/penumbra-cache-escape-" + std::to_string(::getpid());
   std::string upper = hash;
   for (char& c : upper) c = char(std::toupper(static_cast<unsigned char>(c)));
-  const std::string other_hash(64, 'a');  // well formed; the package served hashes differently
-  service.to_lease = {task("escape", escape), task("upper", upper), task("dot", "."),
-                      task("mismatch", other_hash), task("good", hash)};
+  const std::string other_hash(64, 'a');     // well formed; the package served hashes differently
+  v1::Task outside = task("outside", hash);  // a tile past the 32x24 image
+  outside.mutable_tile()->set_x1(4096);
+  service.to_lease = {task("escape", escape),
+                      task("upper", upper),
+                      task("dot", "."),
+                      task("mismatch", other_hash),
+                      outside,
+                      task("good", hash)};
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
@@ -173,7 +180,7 @@ TEST(WorkerCache, AddressedByContentHashOnly) {
   while (std::chrono::steady_clock::now() < deadline) {
     {
       std::lock_guard lock(service.mutex);
-      if (service.failures.size() + service.completions.size() >= 5) break;
+      if (service.failures.size() + service.completions.size() >= 6) break;
     }
     std::this_thread::sleep_for(50ms);
   }
@@ -181,7 +188,7 @@ TEST(WorkerCache, AddressedByContentHashOnly) {
   server->Shutdown(std::chrono::system_clock::now() + 2s);
 
   std::lock_guard lock(service.mutex);
-  for (const char* refused : {"escape", "upper", "dot", "mismatch"})
+  for (const char* refused : {"escape", "upper", "dot", "mismatch", "outside"})
     EXPECT_TRUE(service.failures.count(refused)) << refused << " was not refused";
   EXPECT_NE(service.failures["mismatch"].find(other_hash), std::string::npos)
       << service.failures["mismatch"];
