@@ -8,6 +8,8 @@ void add_local_commands(CLI::App& app);
 void add_reproduce_command(CLI::App& app);
 // submit, watch, list, status, cancel, fetch, workers: the farm's client (client/farm_*.cpp).
 void add_farm_commands(CLI::App& app);
+// batch submit/watch/status/list/cancel/fetch/run and report (client/batch_commands.cpp).
+void add_batch_commands(CLI::App& app);
 // The exit code the command that ran asked for (0 unless it reported a failure itself).
 int command_exit_code();
 void set_command_exit_code(int code);

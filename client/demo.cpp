@@ -1,10 +1,14 @@
-// `penumbra demo`: the bundled comparison on cornell-occluders. Every method renders for the
-// same compute time; a reference renders for longer; the folder gets EXRs, PNG previews and a
-// report (report.md, summary.json) with MRSE over the image and its regions.
+// `penumbra demo`: the bundled comparison on cornell-occluders.
 //
-// With the farm built, the demo runs on an embedded farm: a coordinator on a loopback port and
-// local worker daemons in this process, every render a job through the gRPC API. Without it, the
-// same renders run locally.
+// With the farm built, the demo is the batch batches/demo.json (penumbra/batch@1) run on an
+// embedded farm (a coordinator on a loopback port and local worker daemons in this process):
+// a cached reference, a calibration of every method's cost per pass, then every method for the
+// same compute time, interleaved round-robin. The folder gets the batch result folder
+// (batch.json, reference.exr, runs/*.exr) and its report (report.html, table.csv, charts,
+// figure.png); the summary table is printed. --seconds replaces the batch's budget.
+//
+// Without the farm, the same methods render locally (EXRs, PNG previews, report.md,
+// summary.json).
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "client/batch_commands.h"
 #include "client/commands.h"
 #include "core/image/metrics.h"
 #include "core/method/direct_lighting.h"
@@ -20,22 +25,26 @@
 #include "core/render/local_render.h"
 #include "core/scene/scene.h"
 
-#ifdef PENUMBRA_WITH_FARM
-#include "proto/support/scene_packing.h"
-#include "server/embedded_farm.h"
-#endif
-
-#ifndef PENUMBRA_SCENES_DIR
-#define PENUMBRA_SCENES_DIR "scenes"
-#endif
-
 namespace penumbra {
 
-std::string bundled_scene_path(const std::string& name) {
-  const char* env = std::getenv("PENUMBRA_SCENES");
-  std::filesystem::path dir = env ? env : PENUMBRA_SCENES_DIR;
-  return (dir / (name + ".json")).string();
+#ifdef PENUMBRA_WITH_FARM
+
+void run_local_demo(const std::string& out_dir, double seconds, int threads) {
+  std::string path = bundled_batch_path("demo");
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read the demo batch " + path);
+  nlohmann::json spec = nlohmann::json::parse(in);
+  spec["budget"]["seconds"] = seconds;
+  std::printf("demo: batch %s (%s), %.1f s of compute per method\n", path.c_str(),
+              spec.value("scene", std::string()).c_str(), seconds);
+  BatchRunSettings settings;
+  settings.workers = threads;
+  run_batch(spec.dump(2), path, std::filesystem::path(path).parent_path().string(), out_dir,
+            settings);
+  std::printf("demo: wrote %s/report.html\n", out_dir.c_str());
 }
+
+#else
 
 namespace {
 
@@ -69,41 +78,13 @@ class DemoRenderer {
  public:
   DemoRenderer(std::shared_ptr<const Scene> scene, const std::string& scene_path, int threads)
       : scene_(std::move(scene)), threads_(threads) {
-#ifdef PENUMBRA_WITH_FARM
-    int cores = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    farm::EmbeddedFarmOptions options;
-    options.workers = cores;
-    options.threads_per_worker = 1;
-    farm_ = std::make_unique<farm::EmbeddedFarm>(options);
-    package_ = farm::pack_scene_file(scene_path);
-    std::printf("demo: embedded farm at %s with %d worker(s)\n", farm_->address().c_str(), cores);
-#else
     (void)scene_path;
-#endif
   }
 
   DemoRender render(const DemoEntry& entry, double seconds, uint64_t seed) {
     // Refuse what the estimator cannot run before it reaches a worker (FormatError).
     DirectLighting check(*scene_, parse_method(entry.method));
     DemoRender out;
-#ifdef PENUMBRA_WITH_FARM
-    v1::JobSpec spec;
-    *spec.mutable_scene() = package_;
-    spec.set_method(entry.method);
-    spec.set_sampler(entry.sampler);
-    spec.set_seed(seed);
-    spec.set_compute_seconds(seconds);
-    spec.set_passes_per_task(1);  // stop close to the budget: one pass per task
-    spec.set_name("demo " + entry.method);
-    std::string id = farm_->submit(spec);
-    v1::JobStatus status = farm_->wait(id);
-    if (status.state() != v1::JOB_STATE_DONE)
-      throw std::runtime_error("demo job " + id + " (" + entry.method + ") ended " +
-                               v1::JobState_Name(status.state()) + ": " + status.error());
-    out.film = farm_->film(id);
-    out.spp = status.passes_complete();
-    out.compute_seconds = status.compute_seconds();
-#else
     Renderer renderer(scene_, RenderOptions{entry.method, *parse_pattern(entry.sampler), seed});
     RenderBudget budget;
     budget.seconds = seconds;
@@ -111,17 +92,12 @@ class DemoRenderer {
     out.film = std::move(result.film);
     out.spp = result.spp;
     out.compute_seconds = result.compute_seconds;
-#endif
     return out;
   }
 
  private:
   std::shared_ptr<const Scene> scene_;
   int threads_;
-#ifdef PENUMBRA_WITH_FARM
-  std::unique_ptr<farm::EmbeddedFarm> farm_;
-  v1::ScenePackage package_;
-#endif
 };
 
 }  // namespace
@@ -212,5 +188,7 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
     report << "Not run (refused by the estimator for this scene):\n\n" << skipped;
   std::printf("demo: wrote %s/report.md\n", out_dir.c_str());
 }
+
+#endif  // PENUMBRA_WITH_FARM
 
 }  // namespace penumbra

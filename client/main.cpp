@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   penumbra::add_local_commands(app);
 #ifdef PENUMBRA_WITH_FARM
   penumbra::add_farm_commands(app);
+  penumbra::add_batch_commands(app);
 #endif
   try {
     app.parse(argc, argv);

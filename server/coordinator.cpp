@@ -158,7 +158,7 @@ void Coordinator::resume(const JobRecord& record) {
   j.record.blocks_opened = std::max<uint32_t>(j.record.blocks_opened, 1);
   j.tasks_completed_ever = uint64_t(j.record.blocks_sealed) * j.tile_count + j.pending.size();
   j.task_seconds_ever = j.record.compute_seconds;
-  scheduler_.add_job(record.id, record.priority, record.id);
+  scheduler_.add_job(record.id, record.priority, record.id, batch_group(j.spec().batch_id()));
   for (uint64_t task = uint64_t(j.record.blocks_sealed) * j.tile_count;
        task < uint64_t(j.record.blocks_opened) * j.tile_count; ++task)
     if (!j.pending.count(task)) scheduler_.enqueue({record.id, task});
@@ -169,9 +169,34 @@ void Coordinator::resume(const JobRecord& record) {
   if (!is_terminal(j.record.state)) maybe_open_block(j);
 }
 
+uint64_t Coordinator::batch_group(const std::string& batch_id) {
+  if (batch_id.rfind("batch-", 0) != 0) return 0;
+  std::string digits = batch_id.substr(6);
+  if (digits.empty() || digits.size() > 18 ||
+      !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return 0;
+  return std::stoull(digits);
+}
+
 v1::SubmitJobResponse Coordinator::submit(const v1::JobSpec& request) {
-  // Validation and scene parsing happen outside the lock: they can take a while.
   v1::JobSpec spec = request;
+  spec.clear_batch_id();  // only the batch manager sets it (submit_in_batch)
+  return submit_spec(std::move(spec));
+}
+
+v1::SubmitJobResponse Coordinator::submit_in_batch(const v1::JobSpec& request,
+                                                   const std::string& batch_id) {
+  v1::JobSpec spec = request;
+  spec.set_batch_id(batch_id);
+  return submit_spec(std::move(spec));
+}
+
+void Coordinator::store_scene(const std::string& scene_hash, const v1::ScenePackage& package) {
+  store_.put_scene(scene_hash, package.SerializeAsString());
+}
+
+v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec) {
+  // Validation and scene parsing happen outside the lock: they can take a while.
   if (spec.method().empty()) throw invalid("spec.method: empty; give a method such as \"sa\"");
   try {
     parse_method(spec.method());
@@ -301,7 +326,7 @@ v1::SubmitJobResponse Coordinator::submit(const v1::JobSpec& request) {
     uint64_t id = job->record.id;
     Job& j = *job;
     jobs_[id] = std::move(job);
-    scheduler_.add_job(id, spec.priority(), id);
+    scheduler_.add_job(id, spec.priority(), id, batch_group(spec.batch_id()));
     if (j.seconds_budget()) {
       open_block(j);
     } else {

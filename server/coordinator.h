@@ -74,8 +74,13 @@ class Coordinator {
   Coordinator(const Coordinator&) = delete;
   Coordinator& operator=(const Coordinator&) = delete;
 
-  // Jobs (clients).
+  // Jobs (clients). A client's spec.batch_id is ignored.
   v1::SubmitJobResponse submit(const v1::JobSpec& spec);
+  // A job of a batch (server/batch_manager.h): served round-robin with the batch's other jobs.
+  v1::SubmitJobResponse submit_in_batch(const v1::JobSpec& spec, const std::string& batch_id);
+  // Stores a scene package (already parsed and validated by the caller) under its hash, so
+  // jobs may name it by scene_hash.
+  void store_scene(const std::string& scene_hash, const v1::ScenePackage& package);
   v1::JobStatus status(const std::string& job_id, bool with_curve = true);
   std::vector<v1::JobStatus> list();
   v1::JobState cancel(const std::string& job_id);
@@ -106,6 +111,10 @@ class Coordinator {
   void expire_leases();
 
   static std::string job_name(uint64_t job_id);
+  const CoordinatorOptions& options() const { return options_; }
+  const SceneParser& scene_parser() const { return parser_; }
+  // The scheduler group of a batch id ("batch-3" -> 3); 0 (no group) for anything else.
+  static uint64_t batch_group(const std::string& batch_id);
 
  private:
   struct Job;
@@ -119,6 +128,7 @@ class Coordinator {
   };
   using Notifications = std::vector<std::function<void()>>;
 
+  v1::SubmitJobResponse submit_spec(v1::JobSpec spec);
   uint64_t parse_job_id(const std::string& job_id) const;
   Job& job_locked(const std::string& job_id);
   Worker& worker_locked(const std::string& worker_id);

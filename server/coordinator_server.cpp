@@ -5,6 +5,7 @@
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_builder.h>
 
+#include <algorithm>
 #include <chrono>
 #include <climits>
 #include <stdexcept>
@@ -14,6 +15,13 @@ namespace penumbra::farm {
 CoordinatorServer::CoordinatorServer(Coordinator& coordinator,
                                      const CoordinatorServerOptions& options)
     : jobs_(coordinator), workers_(coordinator) {
+  BatchManagerOptions batch_options;
+  batch_options.data_dir = coordinator.options().data_dir;
+  batch_options.max_spp = coordinator.options().max_spp;
+  batch_options.calibration_share = std::clamp(options.batch_calibration_share, 1e-3, 1.0);
+  batch_manager_ =
+      std::make_unique<BatchManager>(coordinator, coordinator.scene_parser(), batch_options);
+  batches_ = std::make_unique<BatchesService>(*batch_manager_);
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
@@ -21,6 +29,7 @@ CoordinatorServer::CoordinatorServer(Coordinator& coordinator,
   builder.AddListeningPort(options.address, credentials, &port_);
   builder.RegisterService(&jobs_);
   builder.RegisterService(&workers_);
+  builder.RegisterService(batches_.get());
   builder.SetMaxReceiveMessageSize(int(std::min<size_t>(options.max_message_bytes, INT_MAX)));
   builder.SetMaxSendMessageSize(int(std::min<size_t>(options.max_message_bytes, INT_MAX)));
   for (const auto& configure : options.configure) configure(builder);
@@ -30,8 +39,8 @@ CoordinatorServer::CoordinatorServer(Coordinator& coordinator,
 
 CoordinatorServer::CoordinatorServer(Coordinator& coordinator, const std::string& address,
                                      size_t max_message_bytes)
-    : CoordinatorServer(coordinator, CoordinatorServerOptions{address, max_message_bytes, {}, {}}) {
-}
+    : CoordinatorServer(coordinator,
+                        CoordinatorServerOptions{address, max_message_bytes, {}, {}, 0.08}) {}
 
 CoordinatorServer::~CoordinatorServer() {
   shutdown();

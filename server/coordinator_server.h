@@ -1,6 +1,7 @@
 #pragma once
-// Starts the coordinator's gRPC server: jobs and workers services, health checking
-// (grpc.health.v1) and server reflection, on one address.
+// Starts the coordinator's gRPC server: jobs, workers and batches services, health checking
+// (grpc.health.v1) and server reflection, on one address. The batches service's manager
+// (server/batch_manager.h) lives here, with its state in the coordinator's data dir.
 
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server.h>
@@ -11,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "server/batch_manager.h"
+#include "server/batch_service.h"
 #include "server/coordinator.h"
 #include "server/services.h"
 
@@ -24,6 +27,9 @@ struct CoordinatorServerOptions {
   // Called on the builder after the services are registered and before it starts: interceptors
   // (authentication), further services, channel arguments.
   std::vector<std::function<void(grpc::ServerBuilder&)>> configure;
+  // The share of each batch method's budget its calibration job renders for
+  // (server/batch_manager.h).
+  double batch_calibration_share = 0.08;
 };
 
 class CoordinatorServer {
@@ -34,12 +40,15 @@ class CoordinatorServer {
   CoordinatorServer(Coordinator& coordinator, const std::string& address, size_t max_message_bytes);
   ~CoordinatorServer();
   int port() const { return port_; }
+  BatchManager& batches() { return *batch_manager_; }
   void wait();
   void shutdown();
 
  private:
   JobsService jobs_;
   WorkersService workers_;
+  std::unique_ptr<BatchManager> batch_manager_;
+  std::unique_ptr<BatchesService> batches_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
 };

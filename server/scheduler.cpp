@@ -5,9 +5,12 @@
 
 namespace penumbra::farm {
 
-void Scheduler::add_job(uint64_t job_id, int priority, uint64_t sequence) {
+void Scheduler::add_job(uint64_t job_id, int priority, uint64_t sequence, uint64_t group) {
   if (jobs_.count(job_id)) return;
-  jobs_[job_id].key = JobKey{priority, sequence, job_id};
+  JobQueue& queue = jobs_[job_id];
+  if (group != 0) sequence = group_sequences_.emplace(group, sequence).first->second;
+  queue.key = JobKey{priority, sequence, 0, job_id};
+  queue.group = group;
 }
 
 void Scheduler::remove_job(uint64_t job_id) {
@@ -41,7 +44,14 @@ std::optional<TaskRef> Scheduler::next() {
   TaskRef task{queue.key.job_id, queue.tasks.front()};
   queue.tasks.pop_front();
   --queued_total_;
-  if (queue.tasks.empty()) ready_.erase(queue.key);
+  if (queue.group != 0) {
+    // Round-robin within the group: this job goes behind its group's other jobs.
+    ready_.erase(queue.key);
+    queue.key.turn = ++turns_;
+    if (!queue.tasks.empty()) ready_.insert(queue.key);
+  } else if (queue.tasks.empty()) {
+    ready_.erase(queue.key);
+  }
   return task;
 }
 

@@ -64,6 +64,31 @@ TEST(Scheduler, RemovedJobLeavesNothingBehind) {
   EXPECT_THROW(scheduler.enqueue({9, 0}), std::logic_error);
 }
 
+// A batch's jobs (one group) are served one task each in turn, at the queue position of the
+// group's first job; an ungrouped job submitted between them waits behind the whole group.
+TEST(Scheduler, GroupedJobsAreServedRoundRobin) {
+  Scheduler scheduler;
+  scheduler.add_job(1, 0, 1, 9);
+  scheduler.add_job(2, 0, 2);
+  scheduler.add_job(3, 0, 3, 9);
+  scheduler.add_job(4, 0, 4, 9);
+  for (uint64_t task : {0, 1, 2}) scheduler.enqueue({1, task});
+  for (uint64_t task : {0}) scheduler.enqueue({2, task});
+  for (uint64_t task : {0, 1}) scheduler.enqueue({3, task});
+  for (uint64_t task : {0, 1, 2}) scheduler.enqueue({4, task});
+  std::vector<TaskRef> expected = {{1, 0}, {3, 0}, {4, 0}, {1, 1}, {3, 1},
+                                   {4, 1}, {1, 2}, {4, 2}, {2, 0}};
+  EXPECT_EQ(drain(scheduler), expected);
+  // New tasks: the job served longest ago goes first; a requeued task goes first in its job.
+  for (uint64_t task : {3, 4}) scheduler.enqueue({1, task});
+  scheduler.enqueue({3, 2});
+  ASSERT_EQ(scheduler.next(), (TaskRef{3, 2}));  // job 3 was served longest ago
+  ASSERT_EQ(scheduler.next(), (TaskRef{1, 3}));
+  scheduler.requeue({1, 3});
+  std::vector<TaskRef> rest = {{1, 3}, {1, 4}};
+  EXPECT_EQ(drain(scheduler), rest);
+}
+
 }  // namespace
 }  // namespace penumbra::farm
 #else

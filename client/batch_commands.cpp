@@ -1,0 +1,383 @@
+// The client's batch commands (issue #7): `penumbra batch submit|watch|status|list|cancel|fetch|
+// run` and `penumbra report`. They talk to the coordinator's Batches service
+// (proto/support/batch_client.h) named by --coordinator or PENUMBRA_COORDINATOR, with TLS and a
+// token as the farm commands take them; `batch run` without --coordinator starts an embedded
+// farm (server/embedded_farm.h) with --workers local workers.
+#include "client/batch_commands.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "client/commands.h"
+
+#ifdef PENUMBRA_WITH_FARM
+#include "core/report/batch_report.h"
+#include "proto/support/batch_client.h"
+#include "server/embedded_farm.h"
+#endif
+
+#ifndef PENUMBRA_SCENES_DIR
+#define PENUMBRA_SCENES_DIR "scenes"
+#endif
+
+namespace penumbra {
+
+std::string bundled_scene_path(const std::string& name) {
+  const char* env = std::getenv("PENUMBRA_SCENES");
+  std::filesystem::path dir = env && *env ? env : PENUMBRA_SCENES_DIR;
+  return (dir / (name + ".json")).string();
+}
+
+std::string bundled_batch_path(const std::string& name) {
+  const char* env = std::getenv("PENUMBRA_BATCHES");
+  std::filesystem::path dir =
+      env && *env ? std::filesystem::path(env)
+                  : std::filesystem::path(PENUMBRA_SCENES_DIR).parent_path() / "batches";
+  return (dir / (name + ".json")).string();
+}
+
+#ifdef PENUMBRA_WITH_FARM
+
+namespace {
+
+std::string environment(const char* name, const std::string& fallback = "") {
+  const char* value = std::getenv(name);
+  return value && *value ? value : fallback;
+}
+
+struct ConnectionArguments {
+  std::string coordinator = environment("PENUMBRA_COORDINATOR", "127.0.0.1:7420");
+  std::string tls_ca = environment("PENUMBRA_TLS_CA");
+  std::string tls_cert, tls_key, token, token_file;
+};
+
+void add_connection_options(CLI::App* command, ConnectionArguments& connection) {
+  command->add_option("--coordinator", connection.coordinator,
+                      "host:port of the coordinator (default: PENUMBRA_COORDINATOR or "
+                      "127.0.0.1:7420)");
+  command->add_option("--tls-ca", connection.tls_ca,
+                      "PEM file of the CA that signed the coordinator's certificate");
+  command->add_option("--tls-cert", connection.tls_cert, "PEM client certificate (mutual TLS)");
+  command->add_option("--tls-key", connection.tls_key, "PEM private key of --tls-cert");
+  command->add_option("--token", connection.token, "bearer token (prefer --token-file)");
+  command->add_option("--token-file", connection.token_file, "file whose first line is the token");
+}
+
+farm::FarmConnection connection_of(const ConnectionArguments& arguments) {
+  farm::FarmConnection connection;
+  connection.address = arguments.coordinator;
+  connection.tls_ca = arguments.tls_ca;
+  connection.tls_cert = arguments.tls_cert;
+  connection.tls_key = arguments.tls_key;
+  connection.token = farm::resolve_token(arguments.token, arguments.token_file);
+  return connection;
+}
+
+std::string state_name(v1::BatchState state) {
+  switch (state) {
+    case v1::BATCH_STATE_REFERENCE:
+      return "reference";
+    case v1::BATCH_STATE_CALIBRATING:
+      return "calibrating";
+    case v1::BATCH_STATE_RUNNING:
+      return "running";
+    case v1::BATCH_STATE_DONE:
+      return "done";
+    case v1::BATCH_STATE_FAILED:
+      return "failed";
+    case v1::BATCH_STATE_CANCELLED:
+      return "cancelled";
+    default:
+      return "unknown";
+  }
+}
+
+std::string progress_line(const v1::BatchStatus& status) {
+  char text[256];
+  std::snprintf(text, sizeof text, "%s %-11s jobs %u/%u  compute %.1f s  wall %.1f s",
+                status.batch_id().c_str(), state_name(status.state()).c_str(), status.jobs_done(),
+                status.jobs_total(), status.compute_seconds(), status.wall_seconds());
+  return text;
+}
+
+// Follows the batch with one progress line (rewritten in place on a terminal).
+v1::BatchStatus watch_batch(farm::BatchClient& client, const std::string& batch_id) {
+  bool tty = isatty(fileno(stdout));
+  std::string last;
+  v1::BatchStatus final_status = client.watch(batch_id, [&](const v1::BatchStatus& status) {
+    std::string line = progress_line(status);
+    if (line == last) return;
+    last = line;
+    if (tty)
+      std::printf("\r%-90s", line.c_str());
+    else
+      std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  });
+  if (tty) std::printf("\n");
+  return final_status;
+}
+
+void print_status(const v1::BatchStatus& status) {
+  std::printf("batch      %s  %s\n", status.batch_id().c_str(), status.name().c_str());
+  std::printf("state      %s%s%s\n", state_name(status.state()).c_str(),
+              status.error().empty() ? "" : ": ", status.error().c_str());
+  std::printf("scene      %s (%ux%u, %s)\n", status.scene_name().c_str(), status.width(),
+              status.height(), status.scene_hash().substr(0, 12).c_str());
+  const v1::BatchReferenceStatus& reference = status.reference();
+  std::printf("reference  %s %s%s%s %s at %u spp%s\n", reference.kind().c_str(),
+              reference.job_id().c_str(), reference.job_id().empty() ? "" : " ",
+              reference.method().c_str(), reference.sampler().c_str(), reference.spp(),
+              reference.cached() ? " (cached)" : "");
+  std::printf("jobs       %u/%u done; %.2f compute s, %.2f wall s\n", status.jobs_done(),
+              status.jobs_total(), status.compute_seconds(), status.wall_seconds());
+  std::printf("%-32s %-10s %8s %10s %10s %10s\n", "label", "run", "spp", "compute s", "wall s",
+              "MRSE");
+  for (const v1::BatchMethodStatus& method : status.methods()) {
+    if (!method.error().empty()) {
+      std::printf("%-32s refused: %s\n", method.label().c_str(), method.error().c_str());
+      continue;
+    }
+    if (method.runs_size() == 0)
+      std::printf("%-32s %s\n", method.label().c_str(),
+                  method.seconds_per_pass() > 0 ? "calibrated" : "waiting");
+    for (const v1::BatchRun& run : method.runs()) {
+      std::string name =
+          (run.equal_time() ? std::string("equal") : std::to_string(run.spp_planned()) + "spp") +
+          ".r" + std::to_string(run.repeat());
+      std::printf("%-32s %-10s %8u %10.2f %10.2f %10s\n", method.label().c_str(), name.c_str(),
+                  run.job().passes_complete(), run.job().compute_seconds(),
+                  run.job().wall_seconds(),
+                  run.job().has_mrse() ? std::to_string(run.job().mrse()).c_str() : "-");
+    }
+  }
+}
+
+// The summary table from a written result folder: per method, its equal-time runs (else its
+// largest spp level), MRSE over the image and each region.
+void print_summary(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "batch.json");
+  nlohmann::json index = nlohmann::json::parse(in);
+  std::vector<std::string> regions = {"image"};
+  for (const auto& region : index["regions"]) regions.push_back(region["name"]);
+  std::printf("%-34s %6s %9s", "method", "spp", "compute s");
+  for (const std::string& region : regions)
+    std::printf(" %12s", ("MRSE " + region).substr(0, 12).c_str());
+  std::printf("\n");
+  for (const auto& method : index["methods"]) {
+    std::string label = method["label"];
+    if (method.contains("error")) {
+      std::printf("%-34s refused: %s\n", label.c_str(), method["error"].get<std::string>().c_str());
+      continue;
+    }
+    for (const auto& run : method["runs"]) {
+      if (method["budget_seconds"].is_number() && !run.value("equal_time", true)) continue;
+      std::printf("%-34s %6u %9.2f", label.c_str(), run["spp"].get<unsigned>(),
+                  run["compute_seconds"].get<double>());
+      for (const std::string& region : regions)
+        for (const auto& error : run["errors"])
+          if (error["region"] == region) std::printf(" %12.4g", error["mrse"].get<double>());
+      std::printf("  (r%u)\n", run["repeat"].get<unsigned>());
+    }
+  }
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string folder_of(const std::string& path) {
+  std::string folder = std::filesystem::path(path).parent_path().string();
+  return folder.empty() ? "." : folder;
+}
+
+struct SpecArguments {
+  std::string spec;
+  std::string output;
+  ConnectionArguments connection;
+  bool coordinator_given = false;
+  int workers = 0;
+  bool no_report = false;
+};
+
+struct IdArguments {
+  std::string id;
+  std::string output;
+  ConnectionArguments connection;
+};
+
+}  // namespace
+
+std::string run_batch(const std::string& spec_text, const std::string& source_name,
+                      const std::string& base_dir, const std::filesystem::path& out_dir,
+                      const BatchRunSettings& settings) {
+  v1::SubmitBatchRequest request =
+      farm::make_batch_request_from_text(spec_text, source_name, base_dir, bundled_scene_path);
+  std::unique_ptr<farm::EmbeddedFarm> embedded;
+  farm::FarmConnection connection;
+  if (settings.coordinator.empty()) {
+    farm::EmbeddedFarmOptions options;
+    options.workers = settings.workers > 0 ? settings.workers
+                                           : int(std::max(1u, std::thread::hardware_concurrency()));
+    options.threads_per_worker = std::max(1, settings.threads_per_worker);
+    embedded = std::make_unique<farm::EmbeddedFarm>(options);
+    std::printf("batch: embedded farm at %s with %d worker(s)\n", embedded->address().c_str(),
+                options.workers);
+    connection.address = embedded->address();
+  } else {
+    connection.address = settings.coordinator;
+    connection.tls_ca = settings.tls_ca;
+    connection.tls_cert = settings.tls_cert;
+    connection.tls_key = settings.tls_key;
+    connection.token = settings.token;
+  }
+  farm::BatchClient client(connection);
+  v1::SubmitBatchResponse response = client.submit(request);
+  std::printf("%s submitted (scene %s)\n", response.batch_id().c_str(),
+              response.scene_hash().substr(0, 12).c_str());
+  std::fflush(stdout);
+  v1::BatchStatus status = watch_batch(client, response.batch_id());
+  if (status.state() != v1::BATCH_STATE_DONE)
+    throw std::runtime_error(response.batch_id() + " ended " + state_name(status.state()) +
+                             (status.error().empty() ? std::string() : ": " + status.error()));
+  farm::write_batch_result(client, status, out_dir);
+  std::printf("batch: wrote the result folder %s (%.1f s wall, %.1f s compute)\n",
+              out_dir.string().c_str(), status.wall_seconds(), status.compute_seconds());
+  if (settings.print_table) print_summary(out_dir);
+  if (settings.write_report) {
+    write_batch_report(out_dir, out_dir);
+    std::printf("batch: wrote the report %s\n", (out_dir / "report.html").string().c_str());
+  }
+  return response.batch_id();
+}
+
+void add_batch_commands(CLI::App& app) {
+  CLI::App* batch =
+      app.add_subcommand("batch", "Equal-time comparison batches (penumbra/batch@1) on the farm");
+  batch->require_subcommand(1);
+
+  auto run_arguments = std::make_shared<SpecArguments>();
+  CLI::App* run = batch->add_subcommand(
+      "run", "Submit a batch, watch it, fetch its result folder and write its report into DIR");
+  run->add_option("spec", run_arguments->spec, "Batch spec file, or a bundled batch's name")
+      ->required();
+  run->add_option("-o,--output", run_arguments->output, "Output folder")->required();
+  add_connection_options(run, run_arguments->connection);
+  run->add_option("--workers", run_arguments->workers,
+                  "Without --coordinator: local workers of the embedded farm (0: one per core)");
+  run->add_flag("--no-report", run_arguments->no_report, "Write the result folder only");
+  run->callback([run, run_arguments] {
+    std::string path = run_arguments->spec;
+    if (!std::filesystem::exists(path) && path.find('/') == std::string::npos)
+      path = bundled_batch_path(path);
+    BatchRunSettings settings;
+    if (run->get_option("--coordinator")->count() > 0) {
+      settings.coordinator = run_arguments->connection.coordinator;
+      farm::FarmConnection connection = connection_of(run_arguments->connection);
+      settings.tls_ca = connection.tls_ca;
+      settings.tls_cert = connection.tls_cert;
+      settings.tls_key = connection.tls_key;
+      settings.token = connection.token;
+    }
+    settings.workers = run_arguments->workers;
+    settings.write_report = !run_arguments->no_report;
+    run_batch(read_text(path), path, folder_of(path), run_arguments->output, settings);
+  });
+
+  auto submit_arguments = std::make_shared<SpecArguments>();
+  CLI::App* submit = batch->add_subcommand("submit", "Submit a batch; prints its id");
+  submit->add_option("spec", submit_arguments->spec, "Batch spec file")->required();
+  add_connection_options(submit, submit_arguments->connection);
+  submit->callback([submit_arguments] {
+    std::string path = submit_arguments->spec;
+    if (!std::filesystem::exists(path) && path.find('/') == std::string::npos)
+      path = bundled_batch_path(path);
+    farm::BatchClient client(connection_of(submit_arguments->connection));
+    v1::SubmitBatchResponse response =
+        client.submit(farm::make_batch_request(path, bundled_scene_path));
+    std::printf("%s\n", response.batch_id().c_str());
+  });
+
+  auto id_command = [&](const char* name, const char* description,
+                        std::shared_ptr<IdArguments> arguments) {
+    CLI::App* command = batch->add_subcommand(name, description);
+    command->add_option("batch", arguments->id, "Batch id (batch-3)")->required();
+    add_connection_options(command, arguments->connection);
+    return command;
+  };
+  auto watch_arguments = std::make_shared<IdArguments>();
+  id_command("watch", "Follow a batch until it ends", watch_arguments)->callback([watch_arguments] {
+    farm::BatchClient client(connection_of(watch_arguments->connection));
+    v1::BatchStatus status = watch_batch(client, watch_arguments->id);
+    print_status(status);
+    if (status.state() != v1::BATCH_STATE_DONE) set_command_exit_code(1);
+  });
+  auto status_arguments = std::make_shared<IdArguments>();
+  id_command("status", "A batch's state, jobs and errors", status_arguments)
+      ->callback([status_arguments] {
+        farm::BatchClient client(connection_of(status_arguments->connection));
+        print_status(client.status(status_arguments->id));
+      });
+  auto cancel_arguments = std::make_shared<IdArguments>();
+  id_command("cancel", "Cancel a batch's unfinished jobs", cancel_arguments)
+      ->callback([cancel_arguments] {
+        farm::BatchClient client(connection_of(cancel_arguments->connection));
+        print_status(client.cancel(cancel_arguments->id));
+      });
+  auto fetch_arguments = std::make_shared<IdArguments>();
+  CLI::App* fetch =
+      id_command("fetch", "Write a finished batch's result folder into DIR", fetch_arguments);
+  fetch->add_option("-o,--output", fetch_arguments->output, "Output folder")->required();
+  fetch->callback([fetch_arguments] {
+    farm::BatchClient client(connection_of(fetch_arguments->connection));
+    farm::write_batch_result(client, client.status(fetch_arguments->id), fetch_arguments->output);
+    std::printf("wrote %s\n",
+                (std::filesystem::path(fetch_arguments->output) / "batch.json").string().c_str());
+  });
+  auto list_connection = std::make_shared<ConnectionArguments>();
+  CLI::App* list = batch->add_subcommand("list", "List the coordinator's batches");
+  add_connection_options(list, *list_connection);
+  list->callback([list_connection] {
+    farm::BatchClient client(connection_of(*list_connection));
+    for (const v1::BatchStatus& status : client.list())
+      std::printf("%s  %-32s %s\n", progress_line(status).c_str(), status.name().c_str(),
+                  status.scene_name().c_str());
+  });
+
+  auto report_arguments = std::make_shared<IdArguments>();
+  CLI::App* report = app.add_subcommand(
+      "report", "Write a batch's report: from a result folder, or fetched by batch id first");
+  report->add_option("batch", report_arguments->id, "Batch result folder or batch id")->required();
+  report->add_option("-o,--output", report_arguments->output, "Output folder")->required();
+  add_connection_options(report, report_arguments->connection);
+  report->callback([report_arguments] {
+    std::filesystem::path source = report_arguments->id;
+    std::filesystem::path out = report_arguments->output;
+    if (!std::filesystem::is_directory(source)) {
+      farm::BatchClient client(connection_of(report_arguments->connection));
+      source = out / "result";
+      farm::write_batch_result(client, client.status(report_arguments->id), source);
+    }
+    write_batch_report(source, out);
+    std::printf("wrote %s\n", (out / "report.html").string().c_str());
+  });
+}
+
+#endif  // PENUMBRA_WITH_FARM
+
+}  // namespace penumbra

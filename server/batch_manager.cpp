@@ -1,0 +1,608 @@
+#include "server/batch_manager.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/image/image.h"
+#include "core/method/direct_lighting.h"
+#include "core/method/method.h"
+#include "core/scene/json_node.h"
+
+namespace penumbra::farm {
+
+namespace {
+
+int64_t unix_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+bool job_terminal(v1::JobState state) {
+  return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+FarmError invalid(const std::string& message) {
+  return FarmError(FarmErrorCode::InvalidArgument, message);
+}
+
+std::string reference_kind_name(BatchReferenceKind kind) {
+  switch (kind) {
+    case BatchReferenceKind::Auto:
+      return "auto";
+    case BatchReferenceKind::Exr:
+      return "exr";
+    case BatchReferenceKind::Job:
+      return "job";
+  }
+  return "auto";
+}
+
+// The pass count that fills `budget` compute seconds at `seconds_per_pass`.
+uint32_t passes_for_budget(double budget, double seconds_per_pass, uint32_t max_spp) {
+  double passes = budget / std::max(seconds_per_pass, 1e-9);
+  if (!std::isfinite(passes)) return max_spp;
+  return uint32_t(std::clamp<double>(std::llround(passes), 1.0, double(max_spp)));
+}
+
+// Calibration and runs render the same passes per task, so that the per-task overhead in the
+// measured compute seconds (tile setup, the worker's RPC threads) weighs the same per pass.
+constexpr uint32_t kPassesPerTask = 4;
+
+}  // namespace
+
+bool BatchManager::is_terminal(v1::BatchState state) {
+  return state == v1::BATCH_STATE_DONE || state == v1::BATCH_STATE_FAILED ||
+         state == v1::BATCH_STATE_CANCELLED;
+}
+
+BatchManager::BatchManager(Coordinator& coordinator, SceneParser parser,
+                           BatchManagerOptions options)
+    : coordinator_(coordinator),
+      parser_(std::move(parser)),
+      options_(std::move(options)),
+      store_(options_.data_dir) {
+  reference_cache_ = store_.reference_cache();
+  for (v1::StoredBatch& stored : store_.load_all()) {
+    uint64_t number = parse_batch_number(stored.status().batch_id());
+    auto batch = std::make_unique<Batch>();
+    try {
+      batch->spec =
+          parse_batch_spec(stored.status().spec_json(), stored.source_name(), options_.limits);
+    } catch (const std::exception& error) {
+      stored.mutable_status()->set_state(v1::BATCH_STATE_FAILED);
+      stored.mutable_status()->set_error(std::string("stored spec is unreadable: ") + error.what());
+    }
+    batch->stored = std::move(stored);
+    next_number_ = std::max(next_number_, number + 1);
+    if (!is_terminal(batch->stored.status().state()))
+      spdlog::info("{}: resumed ({})", batch->stored.status().batch_id(),
+                   v1::BatchState_Name(batch->stored.status().state()));
+    batches_[number] = std::move(batch);
+  }
+  driver_ = std::thread([this] { drive_loop(); });
+}
+
+BatchManager::~BatchManager() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    ++version_;
+  }
+  wake_.notify_all();
+  changed_.notify_all();
+  if (driver_.joinable()) driver_.join();
+}
+
+v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& request,
+                                             const std::string& owner) {
+  std::string source = request.source_name().empty() ? "batch spec" : request.source_name();
+  BatchSpec spec = parse_batch_spec(request.spec_json(), source, options_.limits);
+  if (!request.has_scene())
+    throw invalid(
+        "scene: the request carries no scene package (the client packs the spec's "
+        "scene \"" +
+        spec.scene + "\")");
+  Scene scene;
+  try {
+    scene = parser_(request.scene());
+  } catch (const FormatError& error) {
+    throw invalid(std::string("scene: ") + error.what());
+  }
+
+  // Regions: the scene's, then the spec's (which must lie inside the image).
+  std::map<std::string, Region> regions = scene.regions;
+  for (const auto& [name, region] : spec.regions) {
+    if (region.x1 > scene.camera.width || region.y1 > scene.camera.height)
+      throw invalid(json_region_path(name) + ": region [" + std::to_string(region.x0) + ", " +
+                    std::to_string(region.y0) + ", " + std::to_string(region.x1) + ", " +
+                    std::to_string(region.y1) + "] lies outside the image (" +
+                    std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height) +
+                    ") (in " + source + ")");
+    regions[name] = region;
+  }
+  for (uint32_t spp : spec.budget_spp)
+    if (spp > options_.max_spp)
+      throw invalid("$.budget.spp: " + std::to_string(spp) +
+                    " exceeds the coordinator's limit of " + std::to_string(options_.max_spp) +
+                    " passes (in " + source + ")");
+  if (spec.reference.kind == BatchReferenceKind::Auto && spec.reference.spp > options_.max_spp)
+    throw invalid("$.reference.spp: " + std::to_string(spec.reference.spp) +
+                  " exceeds the coordinator's limit of " + std::to_string(options_.max_spp) +
+                  " passes (in " + source + ")");
+
+  v1::StoredBatch stored;
+  v1::BatchStatus& status = *stored.mutable_status();
+  v1::BatchReferenceStatus& reference = *status.mutable_reference();
+  reference.set_kind(reference_kind_name(spec.reference.kind));
+  switch (spec.reference.kind) {
+    case BatchReferenceKind::Exr: {
+      if (request.reference_exr().empty())
+        throw invalid("$.reference: the spec names the EXR \"" + spec.reference.exr_path +
+                      "\" but the request carries no reference_exr (in " + source + ")");
+      Image image;
+      try {
+        image = decode_exr(request.reference_exr());
+      } catch (const std::exception& error) {
+        throw invalid("$.reference: \"" + spec.reference.exr_path +
+                      "\" is not a readable EXR: " + error.what());
+      }
+      if (image.width != scene.camera.width || image.height != scene.camera.height)
+        throw invalid("$.reference: \"" + spec.reference.exr_path + "\" is " +
+                      std::to_string(image.width) + "x" + std::to_string(image.height) +
+                      ", the scene is " + std::to_string(scene.camera.width) + "x" +
+                      std::to_string(scene.camera.height));
+      stored.set_reference_exr(request.reference_exr());
+      reference.set_state(v1::JOB_STATE_DONE);
+      break;
+    }
+    case BatchReferenceKind::Job: {
+      v1::JobStatus job;
+      try {
+        job = coordinator_.status(spec.reference.job_id, false);
+      } catch (const FarmError& error) {
+        throw FarmError(error.code(), std::string("$.reference: ") + error.what());
+      }
+      if (job.width() != uint32_t(scene.camera.width) ||
+          job.height() != uint32_t(scene.camera.height))
+        throw invalid("$.reference: " + job.job_id() + " is " + std::to_string(job.width()) + "x" +
+                      std::to_string(job.height()) + ", the scene is " +
+                      std::to_string(scene.camera.width) + "x" +
+                      std::to_string(scene.camera.height));
+      if (job.state() == v1::JOB_STATE_FAILED || job.state() == v1::JOB_STATE_CANCELLED)
+        throw invalid("$.reference: " + job.job_id() + " ended " + v1::JobState_Name(job.state()) +
+                      "; it has no image");
+      reference.set_job_id(job.job_id());
+      reference.set_method(job.method());
+      reference.set_sampler(job.sampler());
+      reference.set_spp(job.spp_budget());
+      break;
+    }
+    case BatchReferenceKind::Auto:
+      reference.set_method(spec.reference.method);
+      reference.set_sampler(spec.reference.sampler);
+      reference.set_spp(spec.reference.spp);
+      break;
+  }
+
+  status.set_name(spec.name);
+  status.set_state(v1::BATCH_STATE_REFERENCE);
+  status.set_spec_json(request.spec_json());
+  status.set_scene_name(scene.name);
+  status.set_scene_hash(scene.content_hash);
+  status.set_width(uint32_t(scene.camera.width));
+  status.set_height(uint32_t(scene.camera.height));
+  for (const auto& [name, region] : regions) {
+    v1::BatchRegion* entry = status.add_regions();
+    entry->set_name(name);
+    entry->mutable_rect()->set_x0(region.x0);
+    entry->mutable_rect()->set_y0(region.y0);
+    entry->mutable_rect()->set_x1(region.x1);
+    entry->mutable_rect()->set_y1(region.y1);
+  }
+  for (const BatchMethodSpec& method : spec.methods) {
+    v1::BatchMethodStatus* entry = status.add_methods();
+    entry->set_label(method.label);
+    entry->set_method(method.method);
+    entry->set_sampler(method.sampler);
+    if (spec.budget_seconds) {
+      entry->set_has_budget_seconds(true);
+      entry->set_budget_seconds(*spec.budget_seconds);
+    }
+    // What the estimator cannot run on this scene never reaches a worker.
+    try {
+      DirectLighting check(scene, parse_method(method.method));
+    } catch (const FormatError& error) {
+      entry->set_error(error.what());
+    }
+  }
+  status.set_submitted_unix_ms(unix_ms());
+  status.set_owner(owner);
+  stored.set_source_name(source);
+
+  coordinator_.store_scene(scene.content_hash, request.scene());
+
+  v1::SubmitBatchResponse response;
+  {
+    std::lock_guard lock(mutex_);
+    uint64_t number = next_number_++;
+    status.set_batch_id(batch_name(number));
+    auto batch = std::make_unique<Batch>();
+    batch->stored = std::move(stored);
+    batch->spec = std::move(spec);
+    Batch& b = *batch;
+    batches_[number] = std::move(batch);
+    store_.save(b.stored);
+    spdlog::info("{}: submitted: \"{}\" on scene {} ({} methods, {} repeats)",
+                 b.stored.status().batch_id(), b.spec.name, scene.name, b.spec.methods.size(),
+                 b.spec.repeats);
+    try {
+      advance(b);
+    } catch (const std::exception& error) {
+      fail(b, error.what());
+    }
+    changed_locked();
+    response.set_batch_id(b.stored.status().batch_id());
+    response.set_scene_hash(scene.content_hash);
+  }
+  wake_.notify_all();
+  return response;
+}
+
+std::string BatchManager::json_region_path(const std::string& name) {
+  return json_member_path("$.regions", name);
+}
+
+BatchManager::Batch& BatchManager::batch_locked(const std::string& batch_id) {
+  uint64_t number = parse_batch_number(batch_id);
+  auto it = batches_.find(number);
+  if (number == 0 || it == batches_.end())
+    throw FarmError(FarmErrorCode::NotFound,
+                    "no batch \"" + batch_id + "\" (batch ids look like batch-3)");
+  return *it->second;
+}
+
+v1::BatchStatus BatchManager::status(const std::string& batch_id, bool with_curves) {
+  std::lock_guard lock(mutex_);
+  return status_locked(batch_locked(batch_id), with_curves);
+}
+
+std::vector<v1::BatchStatus> BatchManager::list() {
+  std::lock_guard lock(mutex_);
+  std::vector<v1::BatchStatus> out;
+  for (auto& [number, batch] : batches_) out.push_back(status_locked(*batch, false));
+  return out;
+}
+
+v1::BatchStatus BatchManager::cancel(const std::string& batch_id) {
+  std::lock_guard lock(mutex_);
+  Batch& batch = batch_locked(batch_id);
+  if (!is_terminal(batch.stored.status().state())) {
+    finish(batch, v1::BATCH_STATE_CANCELLED);
+    changed_locked();
+  }
+  return status_locked(batch, false);
+}
+
+std::string BatchManager::reference_exr(const std::string& batch_id) {
+  std::string job_id;
+  {
+    std::lock_guard lock(mutex_);
+    Batch& batch = batch_locked(batch_id);
+    if (!batch.stored.reference_exr().empty()) return batch.stored.reference_exr();
+    job_id = batch.stored.status().reference().job_id();
+  }
+  if (job_id.empty())
+    throw FarmError(FarmErrorCode::FailedPrecondition,
+                    batch_id + ": the reference is not rendered yet");
+  return coordinator_.result_exr(job_id);
+}
+
+uint64_t BatchManager::version() const {
+  std::lock_guard lock(mutex_);
+  return version_;
+}
+
+uint64_t BatchManager::wait_for_change(uint64_t seen, std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  changed_.wait_for(lock, timeout, [&] { return version_ != seen || stopping_; });
+  return version_;
+}
+
+void BatchManager::changed_locked() {
+  ++version_;
+  changed_.notify_all();
+}
+
+void BatchManager::drive_loop() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    bool active = false;
+    for (auto& [number, batch] : batches_) {
+      if (is_terminal(batch->stored.status().state())) continue;
+      active = true;
+      try {
+        advance(*batch);
+      } catch (const std::exception& error) {
+        spdlog::error("{}: {}", batch->stored.status().batch_id(), error.what());
+        fail(*batch, error.what());
+      }
+    }
+    // Jobs progress without the batch record changing: watchers poll while anything runs.
+    if (active) changed_locked();
+    wake_.wait_for(lock, options_.poll);
+  }
+}
+
+bool BatchManager::advance(Batch& batch) {
+  bool changed = false;
+  for (int step = 0; step < 4; ++step) {
+    v1::BatchState before = batch.stored.status().state();
+    bool moved = false;
+    switch (before) {
+      case v1::BATCH_STATE_REFERENCE:
+        moved = advance_reference(batch);
+        break;
+      case v1::BATCH_STATE_CALIBRATING:
+        moved = advance_calibration(batch);
+        break;
+      case v1::BATCH_STATE_RUNNING:
+        moved = advance_runs(batch);
+        break;
+      default:
+        break;
+    }
+    changed = changed || moved;
+    if (moved) store_.save(batch.stored);
+    if (batch.stored.status().state() == before) break;
+  }
+  return changed;
+}
+
+std::string BatchManager::reference_cache_key(const Batch& batch) const {
+  const BatchReferenceSpec& reference = batch.spec.reference;
+  return batch.stored.status().scene_hash() + "|" + to_string(parse_method(reference.method)) +
+         "|" + reference.sampler + "|" + std::to_string(reference.spp) + "|" +
+         std::to_string(reference.seed);
+}
+
+std::string BatchManager::submit_job(Batch& batch, v1::JobSpec spec, bool in_batch) {
+  spec.set_scene_hash(batch.stored.status().scene_hash());
+  if (spec.name().empty()) spec.set_name(batch.stored.status().batch_id());
+  spec.set_owner(batch.stored.status().owner());
+  v1::SubmitJobResponse response =
+      in_batch ? coordinator_.submit_in_batch(spec, batch.stored.status().batch_id())
+               : coordinator_.submit(spec);
+  return response.job_id();
+}
+
+void BatchManager::attach_reference(const Batch& batch, v1::JobSpec& spec) const {
+  if (!batch.stored.reference_exr().empty())
+    spec.set_reference_exr(batch.stored.reference_exr());
+  else
+    spec.set_reference_job(batch.stored.status().reference().job_id());
+}
+
+bool BatchManager::advance_reference(Batch& batch) {
+  v1::BatchStatus& status = *batch.stored.mutable_status();
+  v1::BatchReferenceStatus& reference = *status.mutable_reference();
+  bool changed = false;
+  if (reference.kind() == "auto" && reference.job_id().empty()) {
+    std::string key = reference_cache_key(batch);
+    auto cached = reference_cache_.find(key);
+    if (cached != reference_cache_.end()) {
+      try {
+        v1::JobStatus job = coordinator_.status(cached->second, false);
+        if (job.state() != v1::JOB_STATE_FAILED && job.state() != v1::JOB_STATE_CANCELLED) {
+          reference.set_job_id(job.job_id());
+          reference.set_cached(true);
+          spdlog::info("{}: reference {} reused (cached for this scene and settings)",
+                       status.batch_id(), job.job_id());
+        }
+      } catch (const FarmError&) {
+        // The cached job is gone: render it again.
+      }
+    }
+    if (reference.job_id().empty()) {
+      v1::JobSpec spec;
+      spec.set_method(batch.spec.reference.method);
+      spec.set_sampler(batch.spec.reference.sampler);
+      spec.set_seed(batch.spec.reference.seed);
+      spec.set_spp(batch.spec.reference.spp);
+      spec.set_name("reference for " + status.scene_name() + " (" + status.batch_id() + ")");
+      reference.set_job_id(submit_job(batch, spec, false));
+      reference_cache_[key] = reference.job_id();
+      store_.save_reference_cache(reference_cache_);
+      spdlog::info("{}: reference {} submitted ({} at {} spp)", status.batch_id(),
+                   reference.job_id(), batch.spec.reference.method, batch.spec.reference.spp);
+    }
+    changed = true;
+  }
+  if (reference.kind() != "exr") {
+    v1::JobStatus job = coordinator_.status(reference.job_id(), false);
+    if (reference.state() != job.state()) {
+      reference.set_state(job.state());
+      changed = true;
+    }
+    if (job.state() == v1::JOB_STATE_FAILED || job.state() == v1::JOB_STATE_CANCELLED) {
+      fail(batch, "the reference " + job.job_id() + " ended " + v1::JobState_Name(job.state()) +
+                      (job.error().empty() ? std::string() : ": " + job.error()));
+      return true;
+    }
+    if (job.state() != v1::JOB_STATE_DONE) return changed;
+  }
+  status.set_state(batch.spec.budget_seconds ? v1::BATCH_STATE_CALIBRATING
+                                             : v1::BATCH_STATE_RUNNING);
+  return true;
+}
+
+bool BatchManager::advance_calibration(Batch& batch) {
+  v1::BatchStatus& status = *batch.stored.mutable_status();
+  bool changed = false;
+  for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
+    if (!method.error().empty() || !method.calibration_job().empty()) continue;
+    v1::JobSpec spec;
+    spec.set_method(method.method());
+    spec.set_sampler(method.sampler());
+    spec.set_seed(batch.spec.seed + 0x9e3779b9ull);  // not the runs' samples
+    // A short seconds budget: as many pass blocks as fit in a small share of the method's
+    // budget (at least one), whatever the scene costs.
+    spec.set_compute_seconds(std::max(1e-3, method.budget_seconds() * options_.calibration_share));
+    spec.set_passes_per_task(kPassesPerTask);
+    spec.set_name(status.batch_id() + " calibration " + method.label());
+    method.set_calibration_job(submit_job(batch, spec, true));
+    changed = true;
+  }
+  std::vector<v1::JobStatus> jobs;
+  for (const v1::BatchMethodStatus& method : status.methods()) {
+    if (!method.error().empty()) continue;
+    jobs.push_back(coordinator_.status(method.calibration_job(), false));
+    if (!job_terminal(jobs.back().state())) return changed;
+  }
+  size_t next = 0;
+  for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
+    if (!method.error().empty()) continue;
+    const v1::JobStatus& job = jobs[next++];
+    if (job.state() != v1::JOB_STATE_DONE || job.passes_complete() == 0 ||
+        !(job.compute_seconds() > 0)) {
+      method.set_error("calibration " + job.job_id() + " ended " + v1::JobState_Name(job.state()) +
+                       (job.error().empty() ? std::string() : ": " + job.error()));
+      continue;
+    }
+    method.set_calibration_passes(job.passes_complete());
+    method.set_seconds_per_pass(job.compute_seconds() / double(job.passes_complete()));
+    spdlog::info("{}: {} costs {:.4f} compute seconds per pass", status.batch_id(), method.label(),
+                 method.seconds_per_pass());
+  }
+  status.set_state(v1::BATCH_STATE_RUNNING);
+  return true;
+}
+
+bool BatchManager::advance_runs(Batch& batch) {
+  v1::BatchStatus& status = *batch.stored.mutable_status();
+  bool submitted = std::any_of(status.methods().begin(), status.methods().end(),
+                               [](const v1::BatchMethodStatus& m) { return m.runs_size() > 0; });
+  bool changed = false;
+  if (!submitted) {
+    // Repeat by repeat, method by method: with round-robin serving every method's jobs advance
+    // together.
+    for (uint32_t repeat = 0; repeat < batch.spec.repeats; ++repeat) {
+      for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
+        if (!method.error().empty()) continue;
+        auto add_run = [&](uint32_t spp, bool equal_time) {
+          v1::JobSpec spec;
+          spec.set_method(method.method());
+          spec.set_sampler(method.sampler());
+          spec.set_seed(batch.spec.seed + repeat);
+          spec.set_spp(spp);
+          spec.set_passes_per_task(kPassesPerTask);
+          std::string name = status.batch_id();
+          name.append(" ").append(method.label()).append(" r").append(std::to_string(repeat));
+          if (equal_time)
+            name.append(" equal time");
+          else
+            name.append(" ").append(std::to_string(spp)).append(" spp");
+          spec.set_name(name);
+          attach_reference(batch, spec);
+          v1::BatchRun* run = method.add_runs();
+          run->set_repeat(repeat);
+          run->set_seed(spec.seed());
+          run->set_equal_time(equal_time);
+          run->set_spp_planned(spp);
+          run->set_job_id(submit_job(batch, spec, true));
+        };
+        if (method.has_budget_seconds())
+          add_run(passes_for_budget(method.budget_seconds(), method.seconds_per_pass(),
+                                    options_.max_spp),
+                  true);
+        for (uint32_t spp : batch.spec.budget_spp) add_run(spp, false);
+      }
+    }
+    store_.save(batch.stored);
+    changed = true;
+  }
+  for (const v1::BatchMethodStatus& method : status.methods())
+    for (const v1::BatchRun& run : method.runs())
+      if (!job_terminal(coordinator_.status(run.job_id(), false).state())) return changed;
+  finish(batch, v1::BATCH_STATE_DONE);
+  return true;
+}
+
+std::vector<std::string> BatchManager::job_ids(const Batch& batch) const {
+  std::vector<std::string> ids;
+  for (const v1::BatchMethodStatus& method : batch.stored.status().methods()) {
+    if (!method.calibration_job().empty()) ids.push_back(method.calibration_job());
+    for (const v1::BatchRun& run : method.runs()) ids.push_back(run.job_id());
+  }
+  return ids;
+}
+
+void BatchManager::fail(Batch& batch, const std::string& error) {
+  batch.stored.mutable_status()->set_error(error);
+  spdlog::error("{}: failed: {}", batch.stored.status().batch_id(), error);
+  finish(batch, v1::BATCH_STATE_FAILED);
+}
+
+void BatchManager::finish(Batch& batch, v1::BatchState state) {
+  if (state != v1::BATCH_STATE_DONE)
+    for (const std::string& job : job_ids(batch)) {
+      try {
+        coordinator_.cancel(job);
+      } catch (const std::exception&) {
+        // Already gone: nothing to cancel.
+      }
+    }
+  batch.stored.mutable_status()->set_state(state);
+  batch.stored.set_finished_unix_ms(unix_ms());
+  store_.save(batch.stored);
+  spdlog::info("{}: {}", batch.stored.status().batch_id(), v1::BatchState_Name(state));
+}
+
+v1::BatchStatus BatchManager::status_locked(const Batch& batch, bool with_curves) {
+  v1::BatchStatus status = batch.stored.status();
+  uint32_t total = 0, done = 0;
+  double compute = 0;
+  auto count = [&](const v1::JobStatus& job) {
+    ++total;
+    if (job_terminal(job.state())) ++done;
+    compute += job.compute_seconds();
+  };
+  v1::BatchReferenceStatus& reference = *status.mutable_reference();
+  if (!reference.job_id().empty()) {
+    try {
+      v1::JobStatus job = coordinator_.status(reference.job_id(), false);
+      reference.set_state(job.state());
+      if (!reference.cached() && reference.kind() == "auto") count(job);
+    } catch (const std::exception&) {
+    }
+  }
+  for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
+    if (!method.calibration_job().empty()) {
+      try {
+        count(coordinator_.status(method.calibration_job(), false));
+      } catch (const std::exception&) {
+      }
+    }
+    for (v1::BatchRun& run : *method.mutable_runs()) {
+      try {
+        *run.mutable_job() = coordinator_.status(run.job_id(), with_curves);
+        count(run.job());
+      } catch (const std::exception& error) {
+        run.mutable_job()->set_error(error.what());
+      }
+    }
+  }
+  status.set_jobs_total(total);
+  status.set_jobs_done(done);
+  status.set_compute_seconds(compute);
+  int64_t end = is_terminal(status.state()) && batch.stored.finished_unix_ms()
+                    ? batch.stored.finished_unix_ms()
+                    : unix_ms();
+  status.set_wall_seconds(double(end - status.submitted_unix_ms()) / 1000.0);
+  return status;
+}
+
+}  // namespace penumbra::farm

@@ -1,0 +1,111 @@
+#pragma once
+// The coordinator's batches (issue #7): an equal-time comparison of several methods on one
+// scene (core/batch/batch_spec.h), run as jobs of the Coordinator. No gRPC here: the service
+// (server/batch_service.h) translates calls; errors are FarmError and FormatError.
+//
+// A batch goes through three phases, driven by a background thread:
+//   1. reference: "auto" renders the spec's reference settings as a job, cached by scene hash
+//      and settings (persisted, so a restarted coordinator reuses it too); "job:<id>" waits for
+//      that job; an uploaded EXR is ready at once.
+//   2. calibration (when the spec has a seconds budget): one short job per method (a seconds
+//      budget of calibration_share of the method's budget, 4 passes per task like the runs),
+//      all interleaved on the same workers; each method's measured compute seconds per pass
+//      gives its pass count for the budget: round(budget / cost).
+//   3. runs: per method and repeat an equal-time job (that pass count) and one job per spp
+//      level, every job against the reference (so the coordinator records the MRSE curve at
+//      every pass boundary). The batch's jobs are served round-robin (server/scheduler.h).
+// A method the estimator refuses for the scene is recorded with its error and never runs.
+// Batches are persisted (server/batch_store.h) and resumed after a restart.
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/batch/batch_spec.h"
+#include "penumbra/v1/farm.pb.h"
+#include "server/batch_store.h"
+#include "server/coordinator.h"
+
+namespace penumbra::farm {
+
+struct BatchManagerOptions {
+  std::string data_dir;  // the coordinator's; batches go in <data_dir>/batches
+  // Each method's calibration job renders for this share of its budget (compute seconds).
+  double calibration_share = 0.08;
+  std::chrono::milliseconds poll{100};
+  BatchLimits limits;
+  uint32_t max_spp = 1u << 20;  // of any job (the coordinator's limit)
+};
+
+class BatchManager {
+ public:
+  // Loads the stored batches and starts driving the unfinished ones.
+  BatchManager(Coordinator& coordinator, SceneParser parser, BatchManagerOptions options);
+  ~BatchManager();
+  BatchManager(const BatchManager&) = delete;
+  BatchManager& operator=(const BatchManager&) = delete;
+
+  // Validates the spec against the scene (FormatError / FarmError InvalidArgument naming the
+  // field; NotFound for an unknown reference job), stores the batch and starts it.
+  v1::SubmitBatchResponse submit(const v1::SubmitBatchRequest& request, const std::string& owner);
+  // NotFound for an unknown id. `with_curves`: the runs' jobs with their MRSE curves.
+  v1::BatchStatus status(const std::string& batch_id, bool with_curves = true);
+  std::vector<v1::BatchStatus> list();
+  // Cancels the batch's unfinished jobs (never a shared auto reference).
+  v1::BatchStatus cancel(const std::string& batch_id);
+  // The reference EXR (the reference job's result or the uploaded file); FailedPrecondition
+  // while it is not rendered yet.
+  std::string reference_exr(const std::string& batch_id);
+
+  // A counter that grows whenever some batch may have changed; wait_for_change blocks until it
+  // differs from `seen` or `timeout` passes, and returns its value.
+  uint64_t version() const;
+  uint64_t wait_for_change(uint64_t seen, std::chrono::milliseconds timeout);
+
+  static bool is_terminal(v1::BatchState state);
+
+ private:
+  struct Batch {
+    v1::StoredBatch stored;
+    BatchSpec spec;
+  };
+
+  static std::string json_region_path(const std::string& name);
+  Batch& batch_locked(const std::string& batch_id);
+  void drive_loop();
+  // Moves the batch on as far as its jobs allow; true when it changed (and was saved).
+  bool advance(Batch& batch);
+  bool advance_reference(Batch& batch);
+  bool advance_calibration(Batch& batch);
+  bool advance_runs(Batch& batch);
+  std::string submit_job(Batch& batch, v1::JobSpec spec, bool in_batch);
+  void attach_reference(const Batch& batch, v1::JobSpec& spec) const;
+  std::string reference_cache_key(const Batch& batch) const;
+  void fail(Batch& batch, const std::string& error);
+  void finish(Batch& batch, v1::BatchState state);
+  std::vector<std::string> job_ids(const Batch& batch) const;
+  v1::BatchStatus status_locked(const Batch& batch, bool with_curves);
+  void changed_locked();
+
+  Coordinator& coordinator_;
+  SceneParser parser_;
+  BatchManagerOptions options_;
+  BatchStore store_;
+  mutable std::mutex mutex_;
+  std::map<uint64_t, std::unique_ptr<Batch>> batches_;
+  uint64_t next_number_ = 1;
+  std::map<std::string, std::string> reference_cache_;
+  uint64_t version_ = 0;
+  std::condition_variable changed_;
+  bool stopping_ = false;
+  std::condition_variable wake_;
+  std::thread driver_;
+};
+
+}  // namespace penumbra::farm
