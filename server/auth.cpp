@@ -56,7 +56,14 @@ CallRegistry& registry() {
 class AuthInterceptor final : public grpc::experimental::Interceptor {
  public:
   AuthInterceptor(grpc::experimental::ServerRpcInfo* info, const AuthPolicy& policy)
-      : info_(info), method_(info->method() ? info->method() : ""), policy_(policy) {}
+      : info_(info), method_(info->method() ? info->method() : ""), policy_(policy) {
+    // Fail closed: until the metadata has been checked, the call counts as refused.
+    CallAuthorization pending;
+    pending.status = grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "not authenticated yet");
+    std::lock_guard lock(registry().mutex);
+    registry().calls[info_->server_context()] = pending;
+    published_ = true;
+  }
 
   ~AuthInterceptor() override {
     if (!published_) return;
@@ -97,7 +104,6 @@ class AuthInterceptor final : public grpc::experimental::Interceptor {
       std::lock_guard lock(registry().mutex);
       registry().calls[context] = decision;
     }
-    published_ = true;
     if (!denied_) return;
     spdlog::warn("refused {} from {}: {}", method_, context->peer(),
                  decision.status.error_message());
