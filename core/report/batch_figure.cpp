@@ -129,6 +129,7 @@ class Canvas {
   // Text centred on `center_x` (or starting at it), shrunk until it fits in `max_width`.
   void text(int x, int baseline, const std::string& text, int size, bool bold, int max_width,
             bool centered = true) {
+    if (text.empty()) return;  // OIIO measures empty text as an undefined ROI
     const char* font = bold ? kFontBold : kFontRegular;
     int width = 0;
     for (; size >= 8; --size) {
@@ -140,6 +141,37 @@ class Canvas {
     int start = centered ? x - width / 2 : x;
     OIIO::ImageBufAlgo::render_text(buffer_, start, baseline, text, std::max(size, 8), font,
                                     {black, 3});
+  }
+
+  // Text broken into centred lines at spaces, each at most `max_width` wide; at most
+  // `max_lines` lines (the last one ends in "..." when the text is longer).
+  void wrapped_text(int center, int baseline, const std::string& text, int size, int max_width,
+                    int max_lines) {
+    std::vector<std::string> words;
+    std::string word;
+    for (char c : text + " ") {
+      if (c != ' ') {
+        word += c;
+      } else if (!word.empty()) {
+        words.push_back(word);
+        word.clear();
+      }
+    }
+    std::vector<std::string> lines;
+    for (const std::string& next : words) {
+      std::string candidate = lines.empty() ? next : lines.back() + " " + next;
+      OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(candidate, size, kFontRegular);
+      if (!lines.empty() && extent.defined() && extent.width() <= max_width)
+        lines.back() = candidate;
+      else
+        lines.push_back(next);
+    }
+    if (int(lines.size()) > max_lines) {
+      lines.resize(size_t(max_lines));
+      lines.back() += " ...";
+    }
+    for (size_t i = 0; i < lines.size(); ++i)
+      this->text(center, baseline + int(i) * (size + 4), lines[i], size, false, max_width);
   }
 
   void write(const std::filesystem::path& path) {
@@ -326,7 +358,9 @@ BatchFigureInfo write_batch_figure(const BatchResult& result, const RecomputedEr
     } else {
       float grey[3] = {0.85f, 0.85f, 0.85f};
       canvas.fill(x, y, x + column_width - 1, y + image_height - 1, grey);
-      canvas.text(center, y + image_height / 2, "refused", 14, true, column_width);
+      canvas.text(center, y + 24, "refused", 14, true, column_width);
+      canvas.wrapped_text(center, y + 46, method->error.empty() ? "no runs" : method->error, 11,
+                          column_width - 12, std::max(1, (image_height - 50) / 15));
     }
     y += image_height + 4;
     std::string under =

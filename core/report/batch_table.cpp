@@ -159,7 +159,8 @@ BatchTable make_batch_table(const BatchResult& result, const RecomputedErrors& r
   std::map<std::string, std::vector<BatchTableRow*>> groups;
   for (BatchTableRow& row : table.rows)
     if (row.refusal.empty()) groups[row.comparison_group].push_back(&row);
-  for (auto& [group, rows] : groups) {
+  for (auto& group : groups) {
+    std::vector<BatchTableRow*>& rows = group.second;
     if (rows.size() < 2) continue;
     auto mark = [&](const std::string& column, auto value_of) {
       double best = INFINITY;
