@@ -117,8 +117,13 @@ v1::BatchStatus watch_batch(farm::BatchClient& client, const std::string& batch_
   std::string last;
   v1::BatchStatus final_status = client.watch(batch_id, [&](const v1::BatchStatus& status) {
     std::string line = progress_line(status);
-    if (line == last) return;
-    last = line;
+    // Not a terminal: one line per phase or finished job, not per progress event.
+    std::string key = tty ? line
+                          : status.batch_id() + state_name(status.state()) +
+                                std::to_string(status.jobs_done()) + "/" +
+                                std::to_string(status.jobs_total());
+    if (key == last) return;
+    last = key;
     if (tty)
       std::printf("\r%-90s", line.c_str());
     else
