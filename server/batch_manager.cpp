@@ -49,8 +49,10 @@ uint32_t passes_for_budget(double budget, double seconds_per_pass, uint32_t max_
 }
 
 // Calibration and runs render the same passes per task, so that the per-task overhead in the
-// measured compute seconds (tile setup, the worker's RPC threads) weighs the same per pass.
-constexpr uint32_t kPassesPerTask = 4;
+// measured compute seconds (tile setup, the worker's RPC threads) weighs the same per pass; one
+// pass per task keeps the calibration's smallest block (every tile, one pass) short on large
+// images.
+constexpr uint32_t kPassesPerTask = 1;
 
 }  // namespace
 

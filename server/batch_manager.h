@@ -8,7 +8,7 @@
 //      and settings (persisted, so a restarted coordinator reuses it too); "job:<id>" waits for
 //      that job; an uploaded EXR is ready at once.
 //   2. calibration (when the spec has a seconds budget): one short job per method (a seconds
-//      budget of calibration_share of the method's budget, 4 passes per task like the runs),
+//      budget of calibration_share of the method's budget, 1 pass per task like the runs),
 //      all interleaved on the same workers; each method's measured compute seconds per pass
 //      gives its pass count for the budget: round(budget / cost).
 //   3. runs: per method and repeat an equal-time job (that pass count) and one job per spp
