@@ -33,7 +33,7 @@ constexpr std::string_view kPage = R"PAGE(<!DOCTYPE html>
   #chart .curve { fill: none; stroke: #3b7dd8; stroke-width: 2; }
   #chart .axis { stroke: #888; stroke-width: 1; }
   #chart text { font-size: 11px; fill: #555; }
-  #preview { border: 1px solid #ddd; image-rendering: pixelated; max-width: 480px;
+  #preview { border: 1px solid #ddd; image-rendering: pixelated; min-width: 288px; max-width: 480px;
              background: #000; }
   .muted { color: #888; }
   #error { color: #c33; }
@@ -171,7 +171,7 @@ function renderChart(job) {
   const sy = (y) => top + (H - top - bottom) * (yMax - y) / (yMax - yMin);
   const d = points.map((p, i) => (i ? "L" : "M") + sx(xs[i]).toFixed(1) + " " + sy(ys[i]).toFixed(1)).join(" ");
   children.push(el("svg:path", {class: "curve", d: d, "data-points": points.length}));
-  for (let i = 0; i < points.length; ++i)
+  for (let i = 0; i < points.length && points.length <= 200; ++i)
     children.push(el("svg:circle", {cx: sx(xs[i]).toFixed(1), cy: sy(ys[i]).toFixed(1), r: 2.5,
                                     fill: "#3b7dd8"}));
   children.push(el("svg:text", {x: left - 4, y: top + 4, "text-anchor": "end"}, Math.pow(10, yMax).toExponential(1)));

@@ -327,7 +327,13 @@ HttpFrontend::HttpFrontend(Coordinator& coordinator, const HttpFrontendOptions& 
     port_ = address.port;
   }
   monitor_.sample();
-  serve_thread_ = std::thread([this] { server_->listen_after_bind(); });
+  serve_thread_ = std::thread([this] {
+    server_->listen_after_bind();
+    serve_finished_ = true;
+  });
+  // stop() only reaches a server that is already accepting: wait for it (a few milliseconds).
+  while (!server_->is_running() && !serve_finished_)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   sample_thread_ = std::thread([this, period = options.sample_period] { sample_loop(period); });
 }
 

@@ -106,6 +106,7 @@ class HttpFrontend {
   std::string host_;
   int port_ = 0;
   std::thread serve_thread_, sample_thread_;
+  std::atomic<bool> serve_finished_{false};
   std::mutex stop_mutex_;
   std::condition_variable stop_wake_;
   bool stopping_ = false;
