@@ -142,7 +142,7 @@ TEST(MultiHost, CoordinatorAndThreeWorkersInNetworkNamespaces) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
     uint64_t seed = 100 + count;
-    v1::JobSpec spec = job_spec(scene, "sa", 64, seed, 16, 4);
+    v1::JobSpec spec = job_spec(scene, "sa", 256, seed, 32, 32);
     auto submitted = std::chrono::steady_clock::now();
     std::string job = client.submit(spec).job_id();
     v1::JobStatus done = client.wait(job, std::chrono::seconds(60));
@@ -157,7 +157,7 @@ TEST(MultiHost, CoordinatorAndThreeWorkersInNetworkNamespaces) {
                    std::to_string(tasks_per_second.back()));
     if (count == hosts.size()) {
       // The last job: every worker took part and the image is the local render's, bit for bit.
-      expect_bit_identical(client, job, scene, "sa", 64, seed);
+      expect_bit_identical(client, job, scene, "sa", 256, seed);
       for (const v1::WorkerInfo& worker : client.workers())
         EXPECT_GT(worker.tasks_completed(), 0u) << worker.name();
     }
