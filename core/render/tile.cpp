@@ -131,6 +131,20 @@ TileAccumulator TileAccumulator::deserialize(std::string_view in) {
   for (auto& s : tile.sums_) s = get<Fixed128>(in);
   for (auto& s : tile.squares_) s = get<Fixed128>(in);
   for (auto& c : tile.counts_) c = get<uint32_t>(in);
+  // add_sample clamps each value and its square to 2^60, so in 2^-32 fixed point a pixel's sums
+  // stay within count * 2^92 (< 2^124): anything beyond came from no sample, and merging it could
+  // overflow the 128-bit sums. Squares are never negative.
+  for (size_t pixel = 0; pixel < tile.counts_.size(); ++pixel) {
+    const unsigned __int128 bound = static_cast<unsigned __int128>(tile.counts_[pixel]) << 92;
+    for (int channel = 0; channel < 3; ++channel) {
+      Fixed128 sum = tile.sums_[3 * pixel + channel], square = tile.squares_[3 * pixel + channel];
+      unsigned __int128 magnitude =
+          sum < 0 ? -static_cast<unsigned __int128>(sum) : static_cast<unsigned __int128>(sum);
+      if (magnitude > bound || square < 0 || static_cast<unsigned __int128>(square) > bound)
+        throw std::invalid_argument("tile bytes: pixel " + std::to_string(pixel) +
+                                    " has sums no sample could produce");
+    }
+  }
   return tile;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 namespace penumbra {
@@ -99,6 +100,28 @@ TEST(TileAccumulator, SerializesExactlyAndRejectsBadBytes) {
   EXPECT_THROW(TileAccumulator::deserialize(bad_rect), std::invalid_argument);
   TileAccumulator other({0, 0, 4, 4});
   EXPECT_THROW(other.merge(tile), std::invalid_argument);
+}
+
+// A result whose sums no sample could produce (each sample is clamped to 2^60, so a pixel's sums
+// stay within count * 2^92 in 2^-32 fixed point) is refused: merging it could overflow.
+TEST(TileAccumulator, RejectsSumsNoSampleCouldProduce) {
+  TileRect rect{0, 0, 2, 1};
+  TileAccumulator tile(rect);
+  tile.add_sample(0, {1e30, -1e30, 1e30});  // clamped to +-2^60: still a valid tile
+  tile.add_sample(1, {0.5, 0.5, 0.5});
+  std::string bytes = tile.serialize();
+  ASSERT_TRUE(TileAccumulator::deserialize(bytes) == tile);
+  // Layout: 28-byte header, then 6 sums and 6 squares (16 bytes each), then the counts.
+  auto with_value = [&](size_t slot, Fixed128 value) {
+    std::string b = bytes;
+    std::memcpy(b.data() + 28 + 16 * slot, &value, sizeof value);
+    return b;
+  };
+  const Fixed128 beyond = (Fixed128(1) << 92) + 1;  // one sample's bound, plus one quantum
+  EXPECT_THROW(TileAccumulator::deserialize(with_value(0, beyond)), std::invalid_argument);
+  EXPECT_THROW(TileAccumulator::deserialize(with_value(1, -beyond)), std::invalid_argument);
+  EXPECT_THROW(TileAccumulator::deserialize(with_value(6, -1)), std::invalid_argument);  // square
+  EXPECT_NO_THROW(TileAccumulator::deserialize(with_value(0, Fixed128(1) << 92)));
 }
 
 }  // namespace
