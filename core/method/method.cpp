@@ -52,6 +52,14 @@ auto lookup(const Table& table, std::string_view name) -> const typename Table::
   return nullptr;
 }
 
+// Text quoted in an error message: at most ~60 characters (the message travels as gRPC status
+// metadata, which has a size limit), with the elided length said.
+std::string excerpt(std::string_view text) {
+  constexpr size_t kMax = 60;
+  if (text.size() <= kMax) return std::string(text);
+  return std::string(text.substr(0, kMax)) + "... (" + std::to_string(text.size()) + " characters)";
+}
+
 // A recursive-descent parser over the text with its position, for error messages.
 class MethodParser {
  public:
@@ -72,7 +80,7 @@ class MethodParser {
       std::string_view word = read_word();
       const auto* entry = lookup(kCombines, word);
       if (!entry)
-        fail("unknown combination \"" + std::string(word) + "\"; expected one of " +
+        fail("unknown combination \"" + excerpt(word) + "\"; expected one of " +
              alternatives(kCombines));
       method.combine = entry->second;
     }
@@ -87,7 +95,7 @@ class MethodParser {
   char peek() const { return pos_ < text_.size() ? text_[pos_] : '\0'; }
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw FormatError("method", "\"" + std::string(text_) + "\" " + what + " (at character " +
+    throw FormatError("method", "\"" + excerpt(text_) + "\" " + what + " (at character " +
                                     std::to_string(pos_) + ")");
   }
 
@@ -109,8 +117,7 @@ class MethodParser {
       auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), count);
       if (ec != std::errc() || count < 1 || count > kMaxTermCount) {
         pos_ = start;
-        fail("has count " + std::string(digits) + "; counts are 1.." +
-             std::to_string(kMaxTermCount));
+        fail("has count " + excerpt(digits) + "; counts are 1.." + std::to_string(kMaxTermCount));
       }
       term.count = int(count);
       if (peek() != '*') fail("expected '*' after the count");
@@ -122,7 +129,7 @@ class MethodParser {
     const auto* entry = lookup(kStrategies, word);
     if (!entry) {
       pos_ = word_start;
-      fail("unknown strategy \"" + std::string(word) + "\"; expected one of " +
+      fail("unknown strategy \"" + excerpt(word) + "\"; expected one of " +
            alternatives(kStrategies));
     }
     term.strategy = entry->second;

@@ -212,13 +212,8 @@ method_case("unknown-combine", "bsdf+sa/median", "unknown combination \"median\"
             why="not a combination")
 method_case("trailing-plus", "bsdf+", "method", why="a term is missing")
 method_case("nul-byte", "sa\x00bsdf", "method", why="a NUL byte inside")
-method_case("very-long", "sa" * 5000, "method", why="10 kB of text",
-            extra=["# Known bug: parse_method quotes the whole text in its message, so the status",
-                   "# message (10 kB) passes gRPC's 8 kB metadata limit and the client sees",
-                   "# RESOURCE_EXHAUSTED instead. Fix: quote at most ~60 characters in",
-                   "# core/method/method.cpp (MethodParser::fail). Remove these lines then.",
-                   "known_bug_status: RESOURCE_EXHAUSTED",
-                   "known_bug_message: metadata size exceeds limit"])
+method_case("very-long", "sa" * 5000, "(10000 characters)", why="10 kB of text (the message "
+            "quotes at most 60 characters: it must fit gRPC's status metadata)")
 
 # Batches (the reader; with the Batches service the same through the coordinator).
 def batch_case(name, text, message, why=""):
