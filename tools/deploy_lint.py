@@ -83,7 +83,7 @@ class Build:
     """The built daemons: their flags (from --help) and the packages of their libraries."""
 
     def __init__(self, binary_dir):
-        self.binary_dir = Path(binary_dir) if binary_dir else None
+        self.binary_dir = Path(binary_dir).resolve() if binary_dir else None
         self._flags = {}
 
     def path(self, name):
