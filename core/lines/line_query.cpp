@@ -141,7 +141,8 @@ struct LinearFunction {
 struct NodeTestSetup {
   float region_lower[3], region_upper[3];  // bounding box of the crossing region
   LinearFunction distance, alpha, beta;    // see shadow_triangle.h
-  alignas(16) float depth_magnitude[4];    // depth s = alpha + beta: radius only
+  // Depth s = alpha + beta: its range over a box lies within the sum of theirs, widened by
+  // depth_error (the rounding of the two extra sums; see visible_intervals).
   float depth_error;
   float s_min, s_max;
 };
@@ -215,7 +216,8 @@ unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& set
     const __m128 beta_middle = middle_of(setup.beta, center);
     const __m128 beta_radius = radius_of(setup.beta.error, setup.beta.magnitude, extent);
     const __m128 depth_middle = _mm_add_ps(alpha_middle, beta_middle);
-    const __m128 depth_radius = radius_of(setup.depth_error, setup.depth_magnitude, extent);
+    const __m128 depth_radius =
+        _mm_add_ps(_mm_add_ps(alpha_radius, beta_radius), sse(setup.depth_error));
     const __m128 alpha_lower = _mm_sub_ps(alpha_middle, alpha_radius);
     const __m128 alpha_upper = _mm_add_ps(alpha_middle, alpha_radius);
     const __m128 beta_lower = _mm_sub_ps(beta_middle, beta_radius);
@@ -298,7 +300,8 @@ __attribute__((target("avx"))) unsigned test_children_avx(const LineQuery::Node&
   const __m256 beta_middle = middle_of(setup.beta, center);
   const __m256 beta_radius = radius_of(setup.beta.error, setup.beta.magnitude, extent);
   const __m256 depth_middle = _mm256_add_ps(alpha_middle, beta_middle);
-  const __m256 depth_radius = radius_of(setup.depth_error, setup.depth_magnitude, extent);
+  const __m256 depth_radius =
+      _mm256_add_ps(_mm256_add_ps(alpha_radius, beta_radius), lanes(setup.depth_error));
   const __m256 alpha_lower = _mm256_sub_ps(alpha_middle, alpha_radius);
   const __m256 alpha_upper = _mm256_add_ps(alpha_middle, alpha_radius);
   const __m256 beta_lower = _mm256_sub_ps(beta_middle, beta_radius);
@@ -563,16 +566,11 @@ void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, I
   setup.distance.set(normalize(shadow->plane_normal), x, coordinate_bound);
   setup.alpha.set(shadow->alpha_gradient, x, coordinate_bound);
   setup.beta.set(shadow->beta_gradient, x, coordinate_bound);
-  {
-    // Depth s = alpha + beta: its middle is the sum of theirs, so its error bound is the sum of
-    // theirs too (plus its own, for the radius).
-    const Vec3 depth_gradient = shadow->alpha_gradient + shadow->beta_gradient;
-    const double depth_error =
-        32 * (FLT_EPSILON / 2) * dot(absolute(depth_gradient), coordinate_bound);
-    _mm_store_ps(setup.depth_magnitude,
-                 _mm_andnot_ps(_mm_set1_ps(-0.0f), to_floats(depth_gradient)));
-    setup.depth_error = static_cast<float>(depth_error) + (setup.alpha.error + setup.beta.error);
-  }
+  // Depth s = alpha + beta over a box: within [alpha] + [beta] (each radius already holds its
+  // own error bound), i.e. middle alpha_m + beta_m, radius alpha_r + beta_r. The two extra float
+  // sums round by at most an ulp of (|g_alpha| + |g_beta|).(max |p| + |x|), far below the sum of
+  // the two 32-ulp error terms added here.
+  setup.depth_error = setup.alpha.error + setup.beta.error;
   setup.s_min = static_cast<float>(shadow->s_min);
   setup.s_max = static_cast<float>(shadow->s_max);
   // The bounding box of the part of the shadow triangle that can hold a crossing: depth s in
