@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "core/image/metrics.h"
+#include "core/method/direct_lighting.h"
 #include "core/method/method.h"
 #include "core/render/renderer.h"
 #include "core/sampling/pattern.h"
@@ -58,6 +59,9 @@ struct Coordinator::Job {
   bool has_mrse = false;
   double mrse = 0;
   v1::RegionErrors errors;
+  // A store write of sealing or finishing failed (e.g. the data disk is full): memory was left
+  // as it was before, and the expiry thread tries again.
+  bool store_retry = false;
 
   const v1::JobSpec& spec() const { return stored.spec(); }
   bool seconds_budget() const { return spec().budget_case() == v1::JobSpec::kComputeSeconds; }
@@ -262,6 +266,13 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec) {
   if (!spec.scene_hash().empty() && spec.scene_hash() != scene->content_hash)
     throw invalid("spec.scene_hash: " + spec.scene_hash() + " does not match the scene's hash " +
                   scene->content_hash);
+  // The method must be able to run on this scene (line-bd16 refuses GGX, the Peters
+  // combinations need psa and ltc, ...): refused now, not after a worker's three failures.
+  try {
+    DirectLighting estimator(*scene, parse_method(spec.method()));
+  } catch (const FormatError& error) {
+    throw invalid(error.what());
+  }
 
   std::optional<Image> reference;
   if (spec.reference_case() == v1::JobSpec::kReferenceExr) {
@@ -396,6 +407,12 @@ void Coordinator::seal_ready_blocks(Job& job) {
     if (uint64_t(std::distance(begin_it, end_it)) != job.tile_count) break;
     if (!std::all_of(begin_it, end_it, [](const auto& entry) { return entry.second.durable; }))
       break;
+    // Memory changes only once the store has the block: on a failed write (a full disk) the
+    // sealed tiles, curve and counts are put back and the block is sealed again later.
+    std::vector<TileAccumulator> sealed_before = job.sealed;
+    const double sealed_seconds_before = job.sealed_compute_seconds;
+    const bool has_mrse_before = job.has_mrse;
+    const double mrse_before = job.mrse;
     std::map<uint32_t, std::string> tiles;
     for (auto it = begin_it; it != end_it; ++it) {
       uint32_t tile = uint32_t(it->first - first);
@@ -403,7 +420,6 @@ void Coordinator::seal_ready_blocks(Job& job) {
       job.sealed_compute_seconds += it->second.compute_seconds;
       tiles[tile] = job.sealed[tile].serialize();
     }
-    job.pending.erase(begin_it, end_it);
     ++job.record.blocks_sealed;
     uint32_t passes = task_passes(job, end - 1).second;
     std::optional<CurvePoint> point;
@@ -426,7 +442,21 @@ void Coordinator::seal_ready_blocks(Job& job) {
     }
     JobRecord durable = job.record;
     durable.compute_seconds = job.sealed_compute_seconds;
-    store_.seal_block(durable, tiles, first, end, point);
+    try {
+      store_.seal_block(durable, tiles, first, end, point);
+    } catch (const std::exception& error) {
+      spdlog::error("{}: cannot store sealed passes (will retry): {}", job_name(job.record.id),
+                    error.what());
+      job.sealed = std::move(sealed_before);
+      job.sealed_compute_seconds = sealed_seconds_before;
+      --job.record.blocks_sealed;
+      if (point) job.curve.pop_back();
+      job.has_mrse = has_mrse_before;
+      job.mrse = mrse_before;
+      job.store_retry = true;
+      return;
+    }
+    job.pending.erase(job.pending.lower_bound(first), job.pending.lower_bound(end));
     spdlog::debug("{}: {} passes sealed", job_name(job.record.id), passes);
   }
   maybe_open_block(job);
@@ -457,6 +487,7 @@ void Coordinator::finish(Job& job) {
     return;
   }
   load_reference(job);
+  job.errors.Clear();
   if (job.reference) {
     try {
       for (const auto& [region, summary] :
@@ -475,9 +506,20 @@ void Coordinator::finish(Job& job) {
   if (film.nonfinite_samples)
     spdlog::error("{}: {} samples were not finite (counted as zero)", job_name(job.record.id),
                   film.nonfinite_samples);
-  job.record.state = v1::JOB_STATE_DONE;
-  job.record.finished_unix_ms = unix_ms();
-  store_.finish_job(job.record, exr);
+  // The job is DONE in memory only once the store holds its EXR (a full disk: retried later).
+  JobRecord done = job.record;
+  done.state = v1::JOB_STATE_DONE;
+  done.finished_unix_ms = unix_ms();
+  try {
+    store_.finish_job(done, exr);
+  } catch (const std::exception& error) {
+    spdlog::error("{}: cannot store the result (will retry): {}", job_name(job.record.id),
+                  error.what());
+    job.store_retry = true;
+    return;
+  }
+  job.store_retry = false;
+  job.record = done;
   spdlog::info("{}: done: {} spp, {:.2f} compute seconds, {:.2f} wall seconds",
                job_name(job.record.id), spp, job.record.compute_seconds,
                double(job.record.finished_unix_ms - job.record.started_unix_ms) / 1000.0);
@@ -820,13 +862,18 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
   try {
     store_.add_task_result(job_id, {task_index, request.tile(), request.compute_seconds()});
   } catch (const std::exception& error) {
-    std::lock_guard lock(mutex_);
-    Job& job = *jobs_.at(job_id);
-    if (!is_terminal(job.record.state) && job.pending.erase(task_index)) {
-      job.record.compute_seconds -= request.compute_seconds();
-      scheduler_.requeue({job_id, task_index});
+    {
+      std::lock_guard lock(mutex_);
+      Job& job = *jobs_.at(job_id);
+      if (!is_terminal(job.record.state) && job.pending.erase(task_index)) {
+        job.record.compute_seconds -= request.compute_seconds();
+        scheduler_.requeue({job_id, task_index});
+      }
     }
-    throw FarmError(FarmErrorCode::Internal,
+    // A full disk stays RESOURCE_EXHAUSTED for the worker (it retries later); the rest is
+    // INTERNAL.
+    auto* farm_error = dynamic_cast<const FarmError*>(&error);
+    throw FarmError(farm_error ? farm_error->code() : FarmErrorCode::Internal,
                     std::string("cannot store the result: ") + error.what());
   }
   Notifications notifications;
@@ -870,18 +917,29 @@ void Coordinator::fail_task(const v1::FailTaskRequest& request) {
 }
 
 void Coordinator::expire_leases() {
-  std::lock_guard lock(mutex_);
-  auto expired = leases_.expire(std::chrono::steady_clock::now());
-  std::sort(expired.begin(), expired.end(), [](const Lease& a, const Lease& b) {
-    return std::tuple(a.task.job_id, a.task.task_index) >
-           std::tuple(b.task.job_id, b.task.task_index);
-  });
-  for (const Lease& lease : expired) {
-    spdlog::warn("{} task {}: lease of worker {} expired; task queued again",
-                 job_name(lease.task.job_id), lease.task.task_index, lease.worker_id);
-    scheduler_.requeue(lease.task);
-    ++counters_.leases_expired;
+  Notifications notifications;
+  {
+    std::lock_guard lock(mutex_);
+    auto expired = leases_.expire(std::chrono::steady_clock::now());
+    std::sort(expired.begin(), expired.end(), [](const Lease& a, const Lease& b) {
+      return std::tuple(a.task.job_id, a.task.task_index) >
+             std::tuple(b.task.job_id, b.task.task_index);
+    });
+    for (const Lease& lease : expired) {
+      spdlog::warn("{} task {}: lease of worker {} expired; task queued again",
+                   job_name(lease.task.job_id), lease.task.task_index, lease.worker_id);
+      scheduler_.requeue(lease.task);
+      ++counters_.leases_expired;
+    }
+    // Seal or finish again what a failed store write left (space may have returned).
+    for (auto& [id, job] : jobs_) {
+      if (!job->store_retry || is_terminal(job->record.state)) continue;
+      job->store_retry = false;
+      seal_ready_blocks(*job);
+      collect_notifications(id, notifications);
+    }
   }
+  run(notifications);
 }
 
 Film Coordinator::preview_film(const std::string& job_id, uint32_t* passes) {

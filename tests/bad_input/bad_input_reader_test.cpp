@@ -41,7 +41,7 @@ std::string format_error_of(const std::string& name, Read read) {
 }
 
 TEST(BadInputReaders, EveryCaseHasAnExpectation) {
-  for (const char* folder : {"scenes", "methods", "batches", "requests", "jobs"}) {
+  for (const char* folder : {"scenes", "methods", "batches", "requests"}) {
     auto cases = load_cases(folder);
     EXPECT_FALSE(cases.empty()) << folder;
     for (const BadInputCase& c : cases) {

@@ -372,15 +372,10 @@ request_case("submit-nested-groups-10000", "\x7b" * 10000, "UNIMPLEMENTED", "",
              ["rpc: /penumbra.v1.Jobs/SubmitJob", "raw: yes"],
              why="10,000 nested protobuf groups (past the parser's recursion limit)", suffix=".bin")
 
-# Jobs the coordinator accepts (their method parses) but no worker can render: the job fails with
-# the worker's reason and the worker keeps serving.
-def job_case(name, spec, message, why=""):
-    write("jobs", name + ".textproto", "spec {\n  " + spec + "\n}\n",
-          ["# " + why, "status: OK", "state: JOB_STATE_FAILED", "message: " + message,
-           "scene: good"])
-
-
-job_case("line-direction-rand", 'method: "line-sa:rand" spp: 4', ":rand\\\" is not defined"
-         .replace('\\\\', '\\').replace('\\"', '"'), why="a line direction with no point pdf")
-job_case("peters-weights-without-ltc", 'method: "psa+sa/weighted" spp: 4',
-         "combines one psa term and one ltc term", why="a combination that needs psa and ltc")
+# Methods that parse but cannot run on the scene: the coordinator builds the estimator at
+# submission, so they are refused there (not after a worker's retries).
+submit('method: "line-sa:rand" spp: 4', "INVALID_ARGUMENT", ":rand\" is not defined",
+       "submit-line-direction-rand", why="a line direction with no point pdf")
+submit('method: "psa+sa/weighted" spp: 4', "INVALID_ARGUMENT",
+       "combines one psa term and one ltc term", "submit-peters-weights-without-ltc",
+       why="a combination that needs psa and ltc")
