@@ -5,6 +5,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -281,7 +282,17 @@ void RenderWorker::render_loop() {
       std::shared_ptr<const Renderer> renderer = renderer_for(task);
       const TileRect rect = decoded.tile;
       TileAccumulator accumulator(rect);
-      double cpu_start = process_cpu_seconds();
+      // Compute seconds: with one thread the arena runs the task on this thread (its one slot
+      // is this thread's), so this thread's CPU clock measures the task alone, also when other
+      // workers share the process (the embedded farm); with more threads the process's clock
+      // (a worker daemon is alone in its process).
+      auto cpu_seconds = [single = options_.threads == 1] {
+        if (!single) return process_cpu_seconds();
+        timespec now{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+        return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
+      };
+      double cpu_start = cpu_seconds();
       arena.execute(
           [&] { renderer->render_tile(rect, decoded.pass_begin, decoded.pass_end, accumulator); });
       v1::CompleteTaskRequest completion;
@@ -289,7 +300,7 @@ void RenderWorker::render_loop() {
       completion.set_task_index(task.task_index());
       completion.set_attempt_token(task.attempt_token());
       completion.set_tile(accumulator.serialize());
-      completion.set_compute_seconds(std::max(0.0, process_cpu_seconds() - cpu_start));
+      completion.set_compute_seconds(std::max(0.0, cpu_seconds() - cpu_start));
       outgoing.completion = std::move(completion);
     } catch (const std::exception& error) {
       spdlog::error("{} task {}: {}", task.job_id(), task.task_index(), error.what());
