@@ -7,6 +7,7 @@
 
 #include <optional>
 
+#include "proto/support/batch_client.h"
 #include "tests/deploy/deploy_test_support.h"
 
 namespace penumbra::farm::testing {
@@ -165,6 +166,33 @@ TEST(MultiHost, CoordinatorAndThreeWorkersInNetworkNamespaces) {
   // More workers never make it much slower (on a 2-core machine 3 single-thread workers
   // saturate at about 2x; the figures are printed above for the capacity notes).
   EXPECT_GT(tasks_per_second[1], 0.8 * tasks_per_second[0]);
+
+  // A batch across the hosts: a small auto reference, two methods at two sample counts; every
+  // run ends with its errors against the reference.
+  {
+    std::string spec_text = R"({"format": "penumbra/batch@1", "name": "multihost",
+        "scene": ")" + scene +
+                            R"(", "methods": ["sa", "bsdf+sa"], "budget": {"spp": [4, 8]},
+        "reference": {"method": "bsdf+sa", "spp": 32}, "seed": 3})";
+    BatchClient batches(coordinator_address);
+    auto request = make_batch_request_from_text(spec_text, "multihost-batch.json", dir.string(),
+                                                [](const std::string& name) { return name; });
+    std::string batch = batches.submit(request).batch_id();
+    v1::BatchStatus done = batches.watch(batch, {}, std::chrono::seconds(60));
+    ASSERT_EQ(done.state(), v1::BATCH_STATE_DONE) << done.error();
+    ASSERT_EQ(done.methods_size(), 2);
+    for (const v1::BatchMethodStatus& method : done.methods()) {
+      EXPECT_TRUE(method.error().empty()) << method.label() << ": " << method.error();
+      ASSERT_EQ(method.runs_size(), 2) << method.label();
+      for (const v1::BatchRun& run : method.runs()) {
+        EXPECT_EQ(run.job().state(), v1::JOB_STATE_DONE) << method.label() << " " << run.job_id();
+        EXPECT_EQ(run.job().passes_complete(), run.spp_planned()) << method.label();
+        EXPECT_TRUE(run.job().has_mrse()) << method.label();
+      }
+    }
+    std::printf("multihost: batch %s done in %.2f s wall (%u jobs)\n", batch.c_str(),
+                done.wall_seconds(), done.jobs_total());
+  }
 
   for (auto& worker : workers) worker->signal(SIGTERM);
   for (auto& worker : workers) worker->wait_exit(std::chrono::seconds(30));
