@@ -5,6 +5,7 @@
 // farm (server/embedded_farm.h) with --workers local workers.
 #include "client/batch_commands.h"
 
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -240,6 +241,10 @@ std::string run_batch(const std::string& spec_text, const std::string& source_na
     options.workers = settings.workers > 0 ? settings.workers
                                            : int(std::max(1u, std::thread::hardware_concurrency()));
     options.threads_per_worker = std::max(1, settings.threads_per_worker);
+    // The embedded coordinator and workers log at warn and above: the batch prints its own
+    // progress. PENUMBRA_LOG_LEVEL=info (or debug, trace) shows theirs.
+    const char* level = std::getenv("PENUMBRA_LOG_LEVEL");
+    spdlog::set_level(level ? spdlog::level::from_str(level) : spdlog::level::warn);
     embedded = std::make_unique<farm::EmbeddedFarm>(options);
     std::printf("batch: embedded farm at %s with %d worker(s)\n", embedded->address().c_str(),
                 options.workers);
