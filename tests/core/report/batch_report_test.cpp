@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -46,8 +47,14 @@ const char* kSceneJson = R"({
 const std::map<std::string, Region> kRegions = {{"penumbra", {14, 18, 34, 30}},
                                                 {"corner", {0, 30, 12, 40}}};
 
+// One folder per test, and per process for the suite's shared batch: ctest runs this program's
+// tests in parallel processes, which must not rewrite or delete each other's files.
 fs::path output_root() {
-  return fs::path(PENUMBRA_BINARY_DIR) / "test-output" / "report";
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string folder = test ? std::string(test->name()) : "suite-" + std::to_string(::getpid());
+  fs::path root = fs::path(PENUMBRA_BINARY_DIR) / "test-output" / "report" / folder;
+  fs::create_directories(root);
+  return root;
 }
 
 std::string read_text(const fs::path& path) {
@@ -73,6 +80,8 @@ nlohmann::json errors_json(const Image& image, const Image& reference) {
 // Renders the batch result folder once per test program.
 class BatchReportTest : public ::testing::Test {
  protected:
+  static void TearDownTestSuite() { fs::remove_all(batch_dir_.parent_path()); }
+
   static void SetUpTestSuite() {
     batch_dir_ = output_root() / "batch";
     fs::remove_all(batch_dir_);
