@@ -39,7 +39,7 @@ TEST(BatchFarm, EqualTimeByCalibrationAndTheResultFolder) {
   CoordinatorProcess coordinator(dir / "data");
   auto worker = testing::start_worker(coordinator.address(), dir, "w1", 1);
 
-  const double budget = 1.5;
+  const double budget = 3.0;
   std::string spec = R"({
     "format": "penumbra/batch@1", "name": "e2e", "scene": "batch-test.json",
     "methods": ["sa", {"method": "12*sa", "label": "many-sa"}, "line-bd16"],
