@@ -99,6 +99,12 @@ void check_obj_vertex_lines(std::string_view text) {
     auto is_blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
     size_t start = 0;
     while (start < line.size() && is_blank(line[start])) ++start;
+    // tinyobjloader's vertex weights (`vw`) cast a parsed double to int unchecked (undefined for
+    // 1e999, found by fuzz_obj_package): we have no use for them, so they are refused.
+    if (line.size() >= start + 3 && line[start] == 'v' && line[start + 1] == 'w' &&
+        is_blank(line[start + 2]))
+      throw std::invalid_argument("OBJ line " + std::to_string(line_number) +
+                                  ": vertex weights ('vw') are not supported");
     if (line.size() < start + 2 || line[start] != 'v' || !is_blank(line[start + 1])) continue;
     // The fields after "v", up to a comment.
     line = line.substr(start + 1);
