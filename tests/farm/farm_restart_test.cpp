@@ -23,25 +23,21 @@ using testing::wait_until;
 TEST(FarmRestart, CoordinatorKilledAndRestartedKeepsFinishedTiles) {
   auto dir = testing::fresh_directory("restart");
   std::string scene = testing::write_scene(dir, 96, 64);
-  auto coordinator = std::make_unique<CoordinatorProcess>(dir / "data");
-  int port = coordinator->port();
-  auto worker_a = testing::start_worker(coordinator->address(), dir, "a");
-  auto worker_b = testing::start_worker(coordinator->address(), dir, "b");
+  CoordinatorProcess coordinator(dir / "data");
+  auto worker_a = testing::start_worker(coordinator.address(), dir, "a");
+  auto worker_b = testing::start_worker(coordinator.address(), dir, "b");
   std::string job;
   uint32_t passes_before = 0;
   {
-    FarmClient client(coordinator->address());
+    FarmClient client(coordinator.address());
     job = client.submit(testing::job_spec(scene, "sa", 128, 3, 16, 8)).job_id();
     passes_before = wait_until(client, job, [](const v1::JobStatus& s) {
                       return s.passes_complete() >= 16;
                     }).passes_complete();
   }
-  coordinator->process().signal(SIGKILL);
-  coordinator->process().wait_exit(10s);
-  coordinator.reset();
-  // The same port and data directory: the workers reconnect by themselves.
-  coordinator = std::make_unique<CoordinatorProcess>(dir / "data", port);
-  FarmClient client(coordinator->address());
+  // SIGKILL, then the same port and data directory: the workers reconnect by themselves.
+  coordinator.restart();
+  FarmClient client(coordinator.address());
   v1::JobStatus resumed = client.status(job);
   EXPECT_GE(resumed.passes_complete(), passes_before) << "sealed passes were lost";
   EXPECT_NE(resumed.state(), v1::JOB_STATE_FAILED) << resumed.error();

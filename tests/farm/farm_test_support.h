@@ -191,39 +191,62 @@ inline bool same_bits(const Image& a, const Image& b) {
          std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0;
 }
 
-// A coordinator process on 127.0.0.1 with a short lease time.
+// A coordinator process on 127.0.0.1 with a short lease time. kill() and restart() SIGKILL it and
+// start it again on the same data directory, port and arguments (the workers reconnect by
+// themselves).
 class CoordinatorProcess {
  public:
   CoordinatorProcess(const std::filesystem::path& data_dir, int port = 0,
-                     std::vector<std::string> extra = {}, double lease_seconds = 1.0) {
-    auto port_file = data_dir / "port";
-    std::filesystem::create_directories(data_dir);
+                     std::vector<std::string> extra = {}, double lease_seconds = 1.0)
+      : data_dir_(data_dir), extra_(std::move(extra)), lease_seconds_(lease_seconds) {
+    start(port);
+  }
+  int port() const { return port_; }
+  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  ChildProcess& process() { return *process_; }  // not between kill() and restart()
+
+  // SIGKILL, and wait until it has exited.
+  void kill() {
+    if (!process_) return;
+    process_->signal(SIGKILL);
+    process_->wait_exit(std::chrono::seconds(10));
+    process_.reset();
+  }
+  // kill() if it still runs, then start it again; returns once it listens.
+  void restart() {
+    kill();
+    start(port_);
+  }
+
+ private:
+  void start(int port) {
+    auto port_file = data_dir_ / "port";
+    std::filesystem::create_directories(data_dir_);
     std::filesystem::remove(port_file);
     std::vector<std::string> arguments = {binary("server/penumbra-coordinator"),
                                           "--listen",
                                           "127.0.0.1:" + std::to_string(port),
                                           "--data-dir",
-                                          data_dir.string(),
+                                          data_dir_.string(),
                                           "--port-file",
                                           port_file.string(),
                                           "--lease-seconds",
-                                          std::to_string(lease_seconds)};
-    arguments.insert(arguments.end(), extra.begin(), extra.end());
-    process_ = std::make_unique<ChildProcess>(arguments, (data_dir / "coordinator.log").string());
+                                          std::to_string(lease_seconds_)};
+    arguments.insert(arguments.end(), extra_.begin(), extra_.end());
+    process_ = std::make_unique<ChildProcess>(arguments, (data_dir_ / "coordinator.log").string());
     auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     while (!std::filesystem::exists(port_file)) {
       if (!process_->running() || std::chrono::steady_clock::now() > deadline)
         throw std::runtime_error("coordinator did not start; see " +
-                                 (data_dir / "coordinator.log").string());
+                                 (data_dir_ / "coordinator.log").string());
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     std::ifstream(port_file) >> port_;
   }
-  int port() const { return port_; }
-  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
-  ChildProcess& process() { return *process_; }
 
- private:
+  std::filesystem::path data_dir_;
+  std::vector<std::string> extra_;
+  double lease_seconds_;
   std::unique_ptr<ChildProcess> process_;
   int port_ = 0;
 };

@@ -133,23 +133,29 @@ TEST(FaultDiskFull, CoordinatorRefusesNewJobsFinishesRunningOnesAndRecovers) {
   std::string scene = testing::write_scene(dir, 64, 64);
   auto data = dir / "data";
   SmallDisk disk(data, 24);
-  auto coordinator =
-      std::make_unique<testing::CoordinatorProcess>(data, 0, std::vector<std::string>{}, 1.0);
-  const int port = coordinator->port();
-  const std::string address = coordinator->address();
+  testing::CoordinatorProcess coordinator(data, 0, {}, 1.0);
+  const std::string address = coordinator.address();
   auto worker_a = testing::start_worker(address, dir, "a");
   auto worker_b = testing::start_worker(address, dir, "b");
   FarmClient client(address);
 
+  // The running job: 16 tiles x 16 blocks of 64 passes. The disk fills once its first block is
+  // sealed, with 15/16 of its work (about a second of one thread) still to come: it is still
+  // running when the fill is over (ten milliseconds), however fast the machine. Its writes are
+  // those of 16 blocks whatever their length, as many as the reserve was sized for.
   std::vector<SubmittedJob> jobs;
-  SubmittedJob running{"", "sa", 64, 41};
-  running.id = client.submit(testing::job_spec(scene, "sa", 64, 41, 16, 4)).job_id();
+  SubmittedJob running{"", "sa", 1024, 41};
+  running.id = client.submit(testing::job_spec(scene, "sa", 1024, 41, 16, 64)).job_id();
   jobs.push_back(running);
   testing::wait_until(client, running.id,
-                      [](const v1::JobStatus& s) { return s.passes_complete() >= 4; });
+                      [](const v1::JobStatus& s) { return s.passes_complete() >= 64; });
 
   uint64_t filled = disk.fill("filler");
-  std::printf("disk filled with %.1f MiB\n", double(filled) / double(1 << 20));
+  v1::JobStatus at_fill = client.status(running.id);
+  std::printf("disk filled with %.1f MiB; the running job at %u of %u passes\n",
+              double(filled) / double(1 << 20), at_fill.passes_complete(), running.spp);
+  ASSERT_FALSE(job_ended(at_fill.state()))
+      << "the job ended before the disk was full: no running job met the full disk";
   int refusals = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
     try {
@@ -178,7 +184,7 @@ TEST(FaultDiskFull, CoordinatorRefusesNewJobsFinishesRunningOnesAndRecovers) {
     if (error.code() != grpc::StatusCode::DEADLINE_EXCEEDED) throw;
     finished_while_full = false;
   }
-  EXPECT_TRUE(coordinator->process().running());
+  EXPECT_TRUE(coordinator.process().running());
   EXPECT_FALSE(client.list().empty());
 
   // Space returns: the running job (if it waited) and new jobs complete.
@@ -196,12 +202,9 @@ TEST(FaultDiskFull, CoordinatorRefusesNewJobsFinishesRunningOnesAndRecovers) {
   EXPECT_EQ(status.state(), v1::JOB_STATE_DONE) << status.error();
 
   // No corrupt state: kill it, check the database, restart on it, compare the images.
-  coordinator->process().signal(SIGKILL);
-  coordinator->process().wait_exit(10s);
-  coordinator.reset();
+  coordinator.kill();
   EXPECT_EQ(integrity_check(data / "penumbra.sqlite"), "ok");
-  coordinator =
-      std::make_unique<testing::CoordinatorProcess>(data, port, std::vector<std::string>{}, 1.0);
+  coordinator.restart();
   FaultRow row{"coordinator data disk full (tmpfs)", refusals};
   check_jobs(address, scene, jobs, row);
   record_fault_row(row);

@@ -23,8 +23,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <random>
 #include <tuple>
 
 #include "../farm/farm_test_support.h"
@@ -106,6 +109,11 @@ class FaultTableEnvironment : public ::testing::Environment {
 // ---------------------------------------------------------------------------------------------
 // Jobs and their check against local renders
 
+inline bool job_ended(v1::JobState state) {
+  return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
 struct SubmittedJob {
   std::string id;
   std::string method;
@@ -129,8 +137,7 @@ inline void check_jobs(const std::string& address, const std::string& scene_path
     while (Clock::now() < deadline) {
       try {
         status = client.status(job.id);
-        if (status.state() == v1::JOB_STATE_DONE || status.state() == v1::JOB_STATE_FAILED ||
-            status.state() == v1::JOB_STATE_CANCELLED) {
+        if (job_ended(status.state())) {
           done = status.state() == v1::JOB_STATE_DONE;
           break;
         }
@@ -202,6 +209,110 @@ class InProcessCoordinator {
   std::unique_ptr<Coordinator> coordinator_;
   std::unique_ptr<CoordinatorServer> server_;
 };
+
+// "w<w>", or "w<w>-<restart>" for a restarted one. (Appended rather than "w" + std::to_string(w):
+// GCC 12 warns falsely, -Wrestrict, on that operator+ when inlined.)
+inline std::string worker_name(int w, int restart = 0) {
+  std::string name = "w";
+  name += std::to_string(w);
+  if (restart > 0) name.append("-").append(std::to_string(restart));
+  return name;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The coordinator-kill tests: a coordinator process (lease 1 s) and two single-thread worker
+// processes on loopback (no root needed), the small 64x64 scene in a fresh folder.
+
+struct CoordinatorKillFarm {
+  explicit CoordinatorKillFarm(const std::string& name, int worker_count = 2)
+      : dir(testing::fresh_directory(name)),
+        scene(testing::write_scene(dir, 64, 64)),
+        coordinator(dir / "data", 0, {}, 1.0),
+        address(coordinator.address()) {
+    for (int w = 0; w < worker_count; ++w)
+      workers.push_back(testing::start_worker(address, dir, worker_name(w)));
+  }
+  std::filesystem::path dir;
+  std::string scene;
+  testing::CoordinatorProcess coordinator;
+  std::string address;  // the same across restarts
+  std::vector<std::unique_ptr<testing::ChildProcess>> workers;
+};
+
+// What the coordinator's jobs have done so far (one ListJobs call).
+struct FarmProgress {
+  uint64_t sealed_passes = 0;              // summed over every job
+  int unfinished_jobs = 0;                 // not yet ended
+  bool part_way = false;                   // a job has sealed some passes and is not done
+  std::map<std::string, uint32_t> passes;  // job id -> passes sealed
+};
+
+inline FarmProgress farm_progress(FarmClient& client) {
+  FarmProgress progress;
+  for (const v1::JobStatus& job : client.list()) {
+    progress.sealed_passes += job.passes_complete();
+    progress.passes[job.job_id()] = job.passes_complete();
+    if (job_ended(job.state())) continue;
+    ++progress.unfinished_jobs;
+    progress.part_way |= job.passes_complete() > 0;
+  }
+  return progress;
+}
+
+// Kills the coordinator (SIGKILL) and restarts it on its data directory and port, `wanted`
+// times. Each kill follows the work, not the clock: it comes once the jobs have sealed a random
+// 1..max_passes_between more passes since the last (re)start while a job is part-way, so a fast
+// machine cannot finish the work before the kills and a slow one only takes longer.
+// `keep_busy` sees the jobs at every look (every few milliseconds) and may submit more work;
+// `work_ended` says that no more will come (the kills stop short). After each restart every job
+// must still be there with at least the passes it had sealed, none FAILED; `after_restart` adds
+// the caller's checks. Returns the kills made: fewer than `wanted` only past `deadline` or once
+// the work ended.
+inline int kill_coordinator_on_progress(testing::CoordinatorProcess& coordinator, int wanted,
+                                        uint32_t max_passes_between, std::mt19937& random,
+                                        const std::function<void(const FarmProgress&)>& keep_busy,
+                                        const std::function<bool()>& work_ended,
+                                        const std::function<void()>& after_restart,
+                                        std::chrono::seconds deadline) {
+  const std::string address = coordinator.address();
+  std::uniform_int_distribution<uint32_t> passes_between(1, max_passes_between);
+  const auto start = Clock::now();
+  auto client = std::make_unique<FarmClient>(address);
+  uint64_t sealed_at_start = 0;
+  int kills = 0;
+  while (kills < wanted && Clock::now() - start < deadline && !work_ended()) {
+    // Wait for that much progress with a job still part-way.
+    const uint32_t wanted_passes = passes_between(random);
+    FarmProgress before_kill;
+    bool ready = false;
+    while (!ready && Clock::now() - start < deadline && !work_ended()) {
+      before_kill = farm_progress(*client);
+      keep_busy(before_kill);
+      ready = before_kill.part_way && before_kill.sealed_passes >= sealed_at_start + wanted_passes;
+      if (!ready) std::this_thread::sleep_for(5ms);
+    }
+    if (!ready) break;
+    coordinator.kill();
+    ++kills;
+    std::printf(
+        "kill %d at %.1f s: %llu passes sealed (%u since the last start), %d jobs unfinished\n",
+        kills, seconds_since(start), (unsigned long long)before_kill.sealed_passes,
+        unsigned(before_kill.sealed_passes - sealed_at_start), before_kill.unfinished_jobs);
+    coordinator.restart();
+    // A new channel: the old one backs off after losing its connection.
+    client = std::make_unique<FarmClient>(address);
+    FarmProgress resumed = farm_progress(*client);
+    for (const auto& [job, passes] : before_kill.passes) {
+      EXPECT_TRUE(resumed.passes.count(job)) << job << " is gone after the restart";
+      EXPECT_GE(resumed.passes[job], passes) << job << ": sealed passes were lost in the restart";
+    }
+    for (const v1::JobStatus& job : client->list())
+      EXPECT_NE(job.state(), v1::JOB_STATE_FAILED) << job.job_id() << ": " << job.error();
+    after_restart();
+    sealed_at_start = resumed.sealed_passes;
+  }
+  return kills;
+}
 
 // ---------------------------------------------------------------------------------------------
 // A network namespace joined to this one by a veth pair: host side 10.213.S.1/30 (in this

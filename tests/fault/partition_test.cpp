@@ -39,25 +39,29 @@ TEST(FaultPartition, LateResultsOfACutOffWorkerAreDroppedNotDoubleCounted) {
 
   const int rounds = 2;
   int partitions = 0;
-  uint64_t held_at_cuts = 0;
   Coordinator& core = coordinator.coordinator();
-  for (int round = 0; round < rounds; ++round) {
+  auto deadline = Clock::now() + 120s;
+  while (partitions < rounds) {
+    ASSERT_LT(Clock::now(), deadline) << "the victim was not cut off while holding a lease";
     if (core.counters().queued_tasks < 32) submit();
     // Cut the victim off while it holds leases.
-    auto deadline = Clock::now() + 30s;
     while (coordinator.leased_by("victim") == 0) {
       ASSERT_LT(Clock::now(), deadline) << "the victim never held a lease";
       std::this_thread::sleep_for(2ms);
     }
     uint64_t expired_before = core.counters().leases_expired;
     ns.set_link(false);
-    ++partitions;
     uint64_t held = coordinator.leased_by("victim");
-    held_at_cuts += held;
+    if (held == 0) {
+      // Its lease ended between the look and the cut: no partition of a worker at work, again.
+      ns.set_link(true);
+      continue;
+    }
+    ++partitions;
     std::this_thread::sleep_for(partition);
     uint64_t expired = core.counters().leases_expired - expired_before;
     std::printf("partition %d: victim held %llu leases at the cut; %llu leases expired in %.1f s\n",
-                round + 1, (unsigned long long)held, (unsigned long long)expired,
+                partitions, (unsigned long long)held, (unsigned long long)expired,
                 std::chrono::duration<double>(partition).count());
     EXPECT_GE(expired, held) << "the cut-off worker's leases did not expire";
     EXPECT_EQ(coordinator.leased_by("victim"), 0u);
@@ -77,9 +81,7 @@ TEST(FaultPartition, LateResultsOfACutOffWorkerAreDroppedNotDoubleCounted) {
               (unsigned long long)tasks_total, (unsigned long long)counters.tasks_completed,
               (unsigned long long)counters.leases_expired,
               (unsigned long long)counters.late_results);
-  if (held_at_cuts > 0) {
-    EXPECT_GT(counters.late_results, 0u) << "no late result arrived";
-  }
+  EXPECT_GT(counters.late_results, 0u) << "no late result arrived";
   EXPECT_EQ(counters.tasks_completed, tasks_total) << "a task was counted twice or never";
   EXPECT_EQ(coordinator.completed_by_all(), tasks_total);
   record_fault_row(row);
