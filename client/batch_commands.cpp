@@ -23,6 +23,7 @@
 #include "client/commands.h"
 
 #ifdef PENUMBRA_WITH_FARM
+#include "client/connection_options.h"
 #include "core/report/batch_report.h"
 #include "proto/support/batch_client.h"
 #include "server/embedded_farm.h"
@@ -51,39 +52,6 @@ std::string bundled_batch_path(const std::string& name) {
 #ifdef PENUMBRA_WITH_FARM
 
 namespace {
-
-std::string environment(const char* name, const std::string& fallback = "") {
-  const char* value = std::getenv(name);
-  return value && *value ? value : fallback;
-}
-
-struct ConnectionArguments {
-  std::string coordinator = environment("PENUMBRA_COORDINATOR", "127.0.0.1:7420");
-  std::string tls_ca = environment("PENUMBRA_TLS_CA");
-  std::string tls_cert, tls_key, token, token_file;
-};
-
-void add_connection_options(CLI::App* command, ConnectionArguments& connection) {
-  command->add_option("--coordinator", connection.coordinator,
-                      "host:port of the coordinator (default: PENUMBRA_COORDINATOR or "
-                      "127.0.0.1:7420)");
-  command->add_option("--tls-ca", connection.tls_ca,
-                      "PEM file of the CA that signed the coordinator's certificate");
-  command->add_option("--tls-cert", connection.tls_cert, "PEM client certificate (mutual TLS)");
-  command->add_option("--tls-key", connection.tls_key, "PEM private key of --tls-cert");
-  command->add_option("--token", connection.token, "bearer token (prefer --token-file)");
-  command->add_option("--token-file", connection.token_file, "file whose first line is the token");
-}
-
-farm::FarmConnection connection_of(const ConnectionArguments& arguments) {
-  farm::FarmConnection connection;
-  connection.address = arguments.coordinator;
-  connection.tls_ca = arguments.tls_ca;
-  connection.tls_cert = arguments.tls_cert;
-  connection.tls_key = arguments.tls_key;
-  connection.token = farm::resolve_token(arguments.token, arguments.token_file);
-  return connection;
-}
 
 std::string state_name(v1::BatchState state) {
   switch (state) {

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "client/commands.h"
+#include "client/connection_options.h"
 #include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
 
@@ -26,41 +27,8 @@ namespace {
 
 using farm::FarmClient;
 
-std::string environment(const char* name, const std::string& fallback = "") {
-  const char* value = std::getenv(name);
-  return value && *value ? value : fallback;
-}
-
-// Where the coordinator is and how to authenticate to it.
-struct ConnectionArguments {
-  std::string coordinator = environment("PENUMBRA_COORDINATOR", "127.0.0.1:7420");
-  std::string tls_ca = environment("PENUMBRA_TLS_CA");
-  std::string tls_cert, tls_key, token, token_file;
-};
-
-void add_connection_options(CLI::App* command, ConnectionArguments& connection) {
-  command->add_option("--coordinator", connection.coordinator,
-                      "host:port of the coordinator (default: PENUMBRA_COORDINATOR or "
-                      "127.0.0.1:7420)");
-  command->add_option("--tls-ca", connection.tls_ca,
-                      "PEM file of the CA that signed the coordinator's certificate: connect "
-                      "with TLS (default: PENUMBRA_TLS_CA)");
-  command->add_option("--tls-cert", connection.tls_cert,
-                      "PEM client certificate, for mutual TLS (with --tls-key)");
-  command->add_option("--tls-key", connection.tls_key, "PEM private key of --tls-cert");
-  command->add_option("--token", connection.token,
-                      "bearer token (visible in ps: prefer --token-file or PENUMBRA_TOKEN)");
-  command->add_option("--token-file", connection.token_file, "file whose first line is the token");
-}
-
 FarmClient connect(const ConnectionArguments& arguments) {
-  farm::FarmConnection connection;
-  connection.address = arguments.coordinator;
-  connection.tls_ca = arguments.tls_ca;
-  connection.tls_cert = arguments.tls_cert;
-  connection.tls_key = arguments.tls_key;
-  connection.token = farm::resolve_token(arguments.token, arguments.token_file);
-  return FarmClient(connection);
+  return FarmClient(connection_of(arguments));
 }
 
 std::string state_name(v1::JobState state) {
