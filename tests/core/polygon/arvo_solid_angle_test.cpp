@@ -17,24 +17,9 @@
 namespace penumbra {
 namespace {
 
+using polygon_test::hits_polygon;
 using polygon_test::random_unit_vector;
 using polygon_test::uniform;
-
-// Does the ray along `direction` from the origin meet the polygon (up to tolerance * its size)?
-bool hits_polygon(const std::vector<Vec3>& polygon, const Vec3& direction, double tolerance) {
-  Vec3 n = polygon_test::polygon_normal(polygon);
-  double t = dot(n, polygon[0]) / dot(n, direction);
-  if (!(t > 0)) return false;
-  Vec3 p = direction * t;
-  double size = 0;
-  for (size_t i = 0; i < polygon.size(); ++i)
-    size = std::max(size, length(polygon[(i + 1) % polygon.size()] - polygon[i]));
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    Vec3 e = polygon[(i + 1) % polygon.size()] - polygon[i];
-    if (dot(cross(e, p - polygon[i]), n) / length(e) < -tolerance * size) return false;
-  }
-  return true;
-}
 
 TEST(ArvoSolidAngle, SameMapAsPetersConstruction) {
   std::mt19937_64 rng(37);

@@ -1,8 +1,9 @@
 #pragma once
-// Shared helpers of the polygon tests: random convex polygons, brute-force quadrature of solid
-// angle and projected solid angle, and a chi-square test of a light strategy's samples against
-// its own pdf, binned on the light's plane.
+// Shared helpers of the polygon tests: random convex polygons, whether a direction meets one,
+// brute-force quadrature of solid angle and projected solid angle, and a chi-square test of a light
+// strategy's samples against its own pdf, binned on the light's plane.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -44,6 +45,24 @@ inline std::vector<Vec3> random_convex_polygon(std::mt19937_64& rng, int n, cons
 
 inline Vec3 polygon_normal(const std::vector<Vec3>& v) {
   return normalize(cross(v[1] - v[0], v[2] - v[0]));
+}
+
+// Whether `direction` (from the origin) meets the polygon's plane inside the polygon, up to
+// `tolerance` times the polygon's longest edge.
+inline bool hits_polygon(const std::vector<Vec3>& polygon, const Vec3& direction,
+                         double tolerance) {
+  Vec3 n = polygon_normal(polygon);
+  double t = dot(n, polygon[0]) / dot(n, direction);
+  if (!(t > 0)) return false;
+  Vec3 p = direction * t;
+  double size = 0;
+  for (size_t i = 0; i < polygon.size(); ++i)
+    size = std::max(size, length(polygon[(i + 1) % polygon.size()] - polygon[i]));
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    Vec3 e = polygon[(i + 1) % polygon.size()] - polygon[i];
+    if (dot(cross(e, p - polygon[i]), n) / length(e) < -tolerance * size) return false;
+  }
+  return true;
 }
 
 inline Light polygon_light(const std::vector<Vec3>& vertices) {

@@ -20,6 +20,7 @@
 namespace penumbra {
 namespace {
 
+using polygon_test::hits_polygon;
 using polygon_test::random_convex_polygon;
 using polygon_test::random_unit_vector;
 using polygon_test::uniform;
@@ -36,23 +37,6 @@ std::vector<Vec3> random_configuration(std::mt19937_64& rng) {
   double aspect = 0.1 + 0.9 * uniform(rng);
   return random_convex_polygon(rng, n, direction * distance, random_unit_vector(rng), radius,
                                aspect);
-}
-
-// Whether `direction` (from the origin) meets the polygon's plane inside the polygon, up to a
-// relative tolerance.
-bool hits_polygon(const std::vector<Vec3>& polygon, const Vec3& direction, double tolerance) {
-  Vec3 n = polygon_test::polygon_normal(polygon);
-  double t = dot(n, polygon[0]) / dot(n, direction);
-  if (!(t > 0)) return false;
-  Vec3 p = direction * t;
-  double size = 0;
-  for (size_t i = 0; i < polygon.size(); ++i)
-    size = std::max(size, length(polygon[(i + 1) % polygon.size()] - polygon[i]));
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    Vec3 e = polygon[(i + 1) % polygon.size()] - polygon[i];
-    if (dot(cross(e, p - polygon[i]), n) / length(e) < -tolerance * size) return false;
-  }
-  return true;
 }
 
 TEST(ProjectedSolidAngle, ClosedFormMatchesQuadrature) {
