@@ -9,9 +9,9 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <thread>
 
+#include "farm_bench_support.h"
 #include "penumbra/version.h"
 #include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
@@ -21,26 +21,8 @@
 namespace penumbra::farm {
 namespace {
 
-const char* kSceneJson = R"({
-  "format": "penumbra/scene@1", "name": "bench-plane",
-  "camera": { "position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40,
-              "width": 128, "height": 128 },
-  "materials": { "white": { "type": "lambert", "albedo": [0.8, 0.8, 0.8] } },
-  "shapes": [ { "type": "quad", "origin": [-2, 0, 2], "edge1": [4, 0, 0], "edge2": [0, 0, -4],
-                "material": "white" } ],
-  "lights": [ { "type": "quad", "origin": [-0.5, 1.5, -0.5], "edge1": [1, 0, 0],
-                "edge2": [0, 0, 1], "radiance": [5, 5, 5] } ]
-})";
-
 v1::JobSpec bench_job(uint32_t spp, uint32_t tile_size) {
-  v1::JobSpec spec;
-  spec.mutable_scene()->set_scene_json(kSceneJson);
-  spec.mutable_scene()->set_source_name("bench-plane.json");
-  spec.set_method("sa");
-  spec.set_spp(spp);
-  spec.set_tile_size(tile_size);
-  spec.set_passes_per_task(1);
-  return spec;
+  return bench::plane_job("bench-plane", 128, spp, tile_size);
 }
 
 long resident_kib() {
@@ -53,18 +35,10 @@ long resident_kib() {
   return 0;
 }
 
-std::string fresh_dir() {
-  std::random_device random;
-  auto dir = std::filesystem::temp_directory_path() /
-             ("penumbra-bench-coordinator-" + std::to_string(random()));
-  std::filesystem::remove_all(dir);
-  return dir.string();
-}
-
 // Completions per second with state(0) fake workers, each holding up to 4 tasks.
 void BM_CoordinatorCompletions(benchmark::State& state) {
   const int worker_count = int(state.range(0));
-  std::string dir = fresh_dir();
+  std::string dir = bench::fresh_dir("coordinator").string();
   CoordinatorOptions options;
   options.data_dir = dir;
   Coordinator coordinator(options, parse_wire_package);
@@ -142,7 +116,7 @@ BENCHMARK(BM_CoordinatorCompletions)
 
 // Memory per queued task: resident memory growth while a job of 4096 x 256 tasks sits queued.
 void BM_CoordinatorMemoryPerQueuedTask(benchmark::State& state) {
-  std::string dir = fresh_dir();
+  std::string dir = bench::fresh_dir("coordinator").string();
   CoordinatorOptions options;
   options.data_dir = dir;
   options.max_queued_tasks = 10'000'000;

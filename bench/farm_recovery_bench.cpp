@@ -25,9 +25,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <thread>
 
+#include "farm_bench_support.h"
 #include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
 #include "server/coordinator.h"
@@ -41,40 +41,13 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-const char* kSceneJson = R"({
-  "format": "penumbra/scene@1", "name": "bench-recovery",
-  "camera": { "position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40,
-              "width": 64, "height": 64 },
-  "materials": { "white": { "type": "lambert", "albedo": [0.8, 0.8, 0.8] } },
-  "shapes": [ { "type": "quad", "origin": [-2, 0, 2], "edge1": [4, 0, 0], "edge2": [0, 0, -4],
-                "material": "white" } ],
-  "lights": [ { "type": "quad", "origin": [-0.5, 1.5, -0.5], "edge1": [1, 0, 0],
-                "edge2": [0, 0, 1], "radiance": [5, 5, 5] } ]
-})";
-
 // A job that outlasts the benchmark: 16 tiles of 16x16, 4096 blocks of one pass.
 v1::JobSpec long_job() {
-  v1::JobSpec spec;
-  spec.mutable_scene()->set_scene_json(kSceneJson);
-  spec.mutable_scene()->set_source_name("bench-recovery.json");
-  spec.set_method("sa");
-  spec.set_spp(4096);
-  spec.set_tile_size(16);
-  spec.set_passes_per_task(1);
-  return spec;
+  return bench::plane_job("bench-recovery", 64, 4096, 16);
 }
 
 std::filesystem::path build_dir() {
   return std::filesystem::read_symlink("/proc/self/exe").parent_path().parent_path();
-}
-
-std::filesystem::path fresh_dir(const std::string& name) {
-  std::random_device random;
-  auto dir = std::filesystem::temp_directory_path() /
-             ("penumbra-bench-" + name + "-" + std::to_string(random()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
 }
 
 // A child process (output to a log file), SIGKILLed when destroyed.
@@ -146,7 +119,7 @@ uint32_t leases_held(FarmClient& client) {
 }
 
 void CoordinatorRestartToFirstLease(benchmark::State& state) {
-  auto dir = fresh_dir("restart");
+  auto dir = bench::fresh_dir("restart");
   auto coordinator = start_coordinator(dir, 0);
   const int port = port_of(dir);
   const std::string address = "127.0.0.1:" + std::to_string(port);
@@ -192,7 +165,7 @@ BENCHMARK(CoordinatorRestartToFirstLease)
     ->Unit(benchmark::kMillisecond);
 
 void WorkerLossToTasksElsewhere(benchmark::State& state) {
-  auto dir = fresh_dir("worker-loss");
+  auto dir = bench::fresh_dir("worker-loss");
   CoordinatorOptions options;
   options.data_dir = (dir / "data").string();
   options.lease_time = 1000ms;
