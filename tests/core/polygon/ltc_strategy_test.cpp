@@ -18,6 +18,8 @@
 namespace penumbra {
 namespace {
 
+using polygon_test::light_facing;
+using polygon_test::shading_point;
 using polygon_test::uniform;
 
 Material ggx_material(double roughness) {
@@ -27,22 +29,6 @@ Material ggx_material(double roughness) {
   m.specular = {0.9, 0.5, 0.04};
   m.roughness = roughness;
   return m;
-}
-
-ShadingPoint shading_point(const Vec3& position, const Vec3& normal, const Vec3& wo,
-                           const Material* material) {
-  ShadingPoint sp;
-  sp.position = position;
-  sp.normal = normalize(normal);
-  sp.wo = normalize(wo);
-  sp.material = material;
-  return sp;
-}
-
-Light light_facing(std::vector<Vec3> vertices, const Vec3& x) {
-  if (dot(polygon_test::polygon_normal(vertices), x - vertices[0]) < 0)
-    std::reverse(vertices.begin(), vertices.end());
-  return polygon_test::polygon_light(vertices);
 }
 
 struct Configuration {

@@ -21,17 +21,8 @@
 namespace penumbra {
 namespace {
 
+using polygon_test::shading_point;
 using polygon_test::uniform;
-
-ShadingPoint shading_point(const Vec3& position, const Vec3& normal, const Vec3& wo,
-                           const Material* material) {
-  ShadingPoint sp;
-  sp.position = position;
-  sp.normal = normalize(normal);
-  sp.wo = normalize(wo);
-  sp.material = material;
-  return sp;
-}
 
 Material ggx_material(const Rgb& diffuse, const Rgb& f0, double roughness) {
   Material m;

@@ -19,6 +19,7 @@
 namespace penumbra {
 namespace {
 
+using polygon_test::light_facing;
 using polygon_test::uniform;
 
 ShadingPoint shading_point(const Vec3& position, const Vec3& normal) {
@@ -27,13 +28,6 @@ ShadingPoint shading_point(const Vec3& position, const Vec3& normal) {
   sp.normal = normalize(normal);
   sp.wo = sp.normal;
   return sp;
-}
-
-// A polygon light whose emitting side faces `x` (vertex order reversed if needed).
-Light light_facing(std::vector<Vec3> vertices, const Vec3& x) {
-  if (dot(polygon_test::polygon_normal(vertices), x - vertices[0]) < 0)
-    std::reverse(vertices.begin(), vertices.end());
-  return polygon_test::polygon_light(vertices);
 }
 
 struct Configuration {

@@ -1,7 +1,8 @@
 #pragma once
-// Shared helpers of the polygon tests: random convex polygons, whether a direction meets one,
-// brute-force quadrature of solid angle and projected solid angle, and a chi-square test of a light
-// strategy's samples against its own pdf, binned on the light's plane.
+// Shared helpers of the polygon tests: random convex polygons, whether a direction meets one, a
+// light facing a point, shading points, brute-force quadrature of solid angle and projected
+// solid angle, and a chi-square test of a light strategy's samples against its own pdf, binned
+// on the light's plane.
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +14,7 @@
 
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
+#include "core/strategies/strategy.h"
 
 namespace penumbra::polygon_test {
 
@@ -71,6 +73,24 @@ inline Light polygon_light(const std::vector<Vec3>& vertices) {
   light.vertices = vertices;
   light.normal = polygon_normal(vertices);
   return light;
+}
+
+// A polygon light whose emitting side faces `x` (vertex order reversed if needed).
+inline Light light_facing(std::vector<Vec3> vertices, const Vec3& x) {
+  if (dot(polygon_normal(vertices), x - vertices[0]) < 0)
+    std::reverse(vertices.begin(), vertices.end());
+  return polygon_light(vertices);
+}
+
+// A shading point with its normal and outgoing direction normalized.
+inline ShadingPoint shading_point(const Vec3& position, const Vec3& normal, const Vec3& wo,
+                                  const Material* material) {
+  ShadingPoint sp;
+  sp.position = position;
+  sp.normal = normalize(normal);
+  sp.wo = normalize(wo);
+  sp.material = material;
+  return sp;
 }
 
 inline Light quad_light(const Vec3& origin, const Vec3& edge1, const Vec3& edge2) {
