@@ -43,16 +43,8 @@ Light tilted_rectangle() {
 Light parallelogram() {
   return test::quad_light({-0.3, 1, -0.2}, {0.6, 0, 0}, {0.25, 0, 0.5});
 }
-Light down_polygon(std::vector<Vec3> vertices) {
-  Light light = test::polygon_light(vertices);
-  if (light.normal.y > 0) {
-    std::reverse(vertices.begin(), vertices.end());
-    light = test::polygon_light(vertices);
-  }
-  return light;
-}
 Light triangle() {
-  return down_polygon({{-0.4, 1, -0.2}, {0.3, 1.1, 0.3}, {0.4, 0.9, -0.35}});
+  return test::down_polygon({{-0.4, 1, -0.2}, {0.3, 1.1, 0.3}, {0.4, 0.9, -0.35}});
 }
 Light pentagon() {
   return test::regular_polygon_light({0, 1, 0.1}, {0.1, -1, 0.05}, 0.4, 5);
@@ -208,7 +200,7 @@ TEST(SolidAngleNormalization, CloseAndFarConfigurations) {
   // A 1 cm light 40 m away.
   Light tiny = test::quad_light({-0.005, 40, -0.005}, {0.01, 0, 0}, {0, 0, 0.01});
   check_area_estimate<SolidAngleStrategy>(tiny, {0.3, 0, 0.2}, 4);
-  Light tiny_triangle = down_polygon({{0, 40, 0}, {0.01, 40, 0}, {0, 40, 0.01}});
+  Light tiny_triangle = test::down_polygon({{0, 40, 0}, {0.01, 40, 0}, {0, 40, 0.01}});
   check_area_estimate<SolidAngleStrategy>(tiny_triangle, {0.3, 0, 0.2}, 5);
 }
 

@@ -89,6 +89,16 @@ inline Light disk_light(const Vec3& center, const Vec3& normal, double radius,
   return light;
 }
 
+// A polygon light facing down (-y), the vertex order reversed if needed.
+inline Light down_polygon(std::vector<Vec3> vertices) {
+  Light light = polygon_light(vertices);
+  if (light.normal.y > 0) {
+    std::reverse(vertices.begin(), vertices.end());
+    light = polygon_light(vertices);
+  }
+  return light;
+}
+
 // A regular convex polygon of `count` vertices, counter-clockwise about `normal`.
 inline Light regular_polygon_light(const Vec3& center, const Vec3& normal, double radius, int count,
                                    double rotation = 0.3) {

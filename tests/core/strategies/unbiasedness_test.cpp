@@ -59,22 +59,13 @@ void PrintTo(const UnbiasednessCase& c, std::ostream* os) {
   *os << c.name;
 }
 
-Light down_polygon(std::vector<Vec3> vertices) {
-  Light light = test::polygon_light(vertices);
-  if (light.normal.y > 0) {
-    std::reverse(vertices.begin(), vertices.end());
-    light = test::polygon_light(vertices);
-  }
-  return light;
-}
-
 std::vector<UnbiasednessCase> cases() {
   Rgb le{2, 3, 4};
   std::vector<UnbiasednessCase> all;
   all.push_back({"quad", test::quad_light({-0.3, 1, -0.2}, {0.6, 0, 0}, {0, 0, 0.5}, le)});
   all.push_back(
       {"parallelogram", test::quad_light({-0.3, 1, -0.2}, {0.6, 0, 0}, {0.3, 0.1, 0.5}, le)});
-  Light triangle = down_polygon({{-0.4, 1, -0.2}, {0.3, 1.1, 0.3}, {0.4, 0.9, -0.35}});
+  Light triangle = test::down_polygon({{-0.4, 1, -0.2}, {0.3, 1.1, 0.3}, {0.4, 0.9, -0.35}});
   triangle.radiance = le;
   all.push_back({"triangle", triangle});
   Light pentagon = test::regular_polygon_light({0, 1, 0.1}, {0.1, -1, 0.05}, 0.4, 5);
