@@ -269,26 +269,29 @@ TEST(LineMethods, FiniteInDegenerateConfigurations) {
   }
 }
 
+// The estimator's refusal of `method` on `scene` (its FormatError's message), or "" when it
+// accepts the method.
+std::string refusal(const Scene& scene, const char* method) {
+  try {
+    DirectLighting direct(scene, parse_method(method));
+  } catch (const FormatError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(LineMethods, RefusesWhatIsNotDefinedWithAClearError) {
-  auto message = [](const Scene& scene, const char* method) -> std::string {
-    try {
-      DirectLighting direct(scene, parse_method(method));
-    } catch (const FormatError& e) {
-      return e.what();
-    }
-    return "";
-  };
   Scene rectangle = test_scene(false);
-  EXPECT_NE(message(rectangle, "line-sa:rand").find("no closed-form pdf"), std::string::npos);
-  EXPECT_NE(message(rectangle, "bsdf+line-area:rand").find("use :u or :v"), std::string::npos);
+  EXPECT_NE(refusal(rectangle, "line-sa:rand").find("no closed-form pdf"), std::string::npos);
+  EXPECT_NE(refusal(rectangle, "bsdf+line-area:rand").find("use :u or :v"), std::string::npos);
   Scene parallelogram =
       test_scene(false, quad_light({-0.4, 1, -0.25}, {0.8, 0, 0}, {0.2, 0, 0.5}, {1, 1, 1}));
-  EXPECT_NE(message(parallelogram, "line-sa:u").find("not perpendicular"), std::string::npos);
-  EXPECT_EQ(message(parallelogram, "line-area:u+line-area:v/smooth"), "");
+  EXPECT_NE(refusal(parallelogram, "line-sa:u").find("not perpendicular"), std::string::npos);
+  EXPECT_EQ(refusal(parallelogram, "line-area:u+line-area:v/smooth"), "");
   Scene polygon = test_scene(false);
   polygon.lights[0].type = LightType::Polygon;
-  EXPECT_NE(message(polygon, "line-area:u").find("is a polygon"), std::string::npos);
-  EXPECT_NE(message(polygon, "bsdf+sa/smooth").find("is a polygon"), std::string::npos);
+  EXPECT_NE(refusal(polygon, "line-area:u").find("is a polygon"), std::string::npos);
+  EXPECT_NE(refusal(polygon, "bsdf+sa/smooth").find("is a polygon"), std::string::npos);
 }
 
 // Billen & Dutré's analytic lines through the estimator: alone (u, v, rand) and averaged with a
@@ -335,21 +338,13 @@ TEST(LineMethods, Bd16UnbiasedUnoccludedAndOccluded) {
 }
 
 TEST(LineMethods, Bd16RefusesMisAndUnsupportedMaterials) {
-  auto message = [](const Scene& scene, const char* method) -> std::string {
-    try {
-      DirectLighting direct(scene, parse_method(method));
-    } catch (const FormatError& e) {
-      return e.what();
-    }
-    return "";
-  };
   Scene scene = bd16_scene(false);
-  EXPECT_EQ(message(scene, "line-bd16:rand"), "");
-  EXPECT_NE(message(scene, "bsdf+line-bd16:u").find("no pdf at a point"), std::string::npos);
-  EXPECT_NE(message(scene, "line-sa:u+line-bd16:u/smooth").find("use it alone or with /avg"),
+  EXPECT_EQ(refusal(scene, "line-bd16:rand"), "");
+  EXPECT_NE(refusal(scene, "bsdf+line-bd16:u").find("no pdf at a point"), std::string::npos);
+  EXPECT_NE(refusal(scene, "line-sa:u+line-bd16:u/smooth").find("use it alone or with /avg"),
             std::string::npos);
   Scene glossy = test_scene(false);
-  std::string why = message(glossy, "line-bd16:u");
+  std::string why = refusal(glossy, "line-bd16:u");
   EXPECT_NE(why.find("line-bd16"), std::string::npos) << why;
   EXPECT_NE(why.find("glossy"), std::string::npos) << why;
 }
