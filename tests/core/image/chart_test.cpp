@@ -14,27 +14,14 @@
 #include <stdexcept>
 #include <thread>
 
+#include "image_test_support.h"
+
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path test_directory() {
-  static fs::path directory = [] {
-    fs::path dir =
-        fs::temp_directory_path() / ("penumbra_chart_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    return dir;
-  }();
-  return directory;
-}
-
-class RemoveTestDirectory : public ::testing::Environment {
- public:
-  void TearDown() override { fs::remove_all(test_directory()); }
-};
-const ::testing::Environment* const kRemoveTestDirectory =
-    ::testing::AddGlobalTestEnvironment(new RemoveTestDirectory);
+using image_test::test_directory;
 
 ChartSpec convergence_chart() {
   ChartSpec spec;

@@ -14,30 +14,14 @@
 #include <string>
 
 #include "core/image/image.h"
+#include "image_test_support.h"
 
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh directory for this test program's files.
-fs::path test_directory() {
-  static fs::path directory = [] {
-    fs::path dir =
-        fs::temp_directory_path() / ("penumbra_image_io_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    return dir;
-  }();
-  return directory;
-}
-
-// Removes the directory when the program ends.
-class RemoveTestDirectory : public ::testing::Environment {
- public:
-  void TearDown() override { fs::remove_all(test_directory()); }
-};
-const ::testing::Environment* const kRemoveTestDirectory =
-    ::testing::AddGlobalTestEnvironment(new RemoveTestDirectory);
+using image_test::test_directory;
 
 // Random floats over many magnitudes and both signs, plus special-but-finite values, so a lossy
 // path (half conversion, a float->double->float slip) would change some bits.
