@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "client/commands.h"
+#include "client/read_file.h"
 
 #ifdef PENUMBRA_WITH_FARM
 #include "client/connection_options.h"
@@ -167,14 +168,6 @@ void print_summary(const std::filesystem::path& dir) {
   }
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 std::string folder_of(const std::string& path) {
   std::string folder = std::filesystem::path(path).parent_path().string();
   return folder.empty() ? "." : folder;
@@ -274,7 +267,7 @@ void add_batch_commands(CLI::App& app) {
     }
     settings.workers = run_arguments->workers;
     settings.write_report = !run_arguments->no_report;
-    run_batch(read_text(path), path, folder_of(path), run_arguments->output, settings);
+    run_batch(read_file(path), path, folder_of(path), run_arguments->output, settings);
   });
 
   auto submit_arguments = std::make_shared<SpecArguments>();

@@ -18,6 +18,7 @@
 
 #include "client/commands.h"
 #include "client/connection_options.h"
+#include "client/read_file.h"
 #include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
 
@@ -124,14 +125,6 @@ v1::JobStatus watch_job(FarmClient& client, const std::string& job_id) {
     set_command_exit_code(1);
   }
   return last;
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
 }
 
 struct SubmitArguments {

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "client/commands.h"
+#include "client/read_file.h"
 #include "core/image/metrics.h"
 #include "core/render/local_render.h"
 #include "core/render/probe.h"
@@ -27,14 +28,6 @@ Pattern sampler_from(const std::string& name) {
                                      "\"; expected random, stratified, uniform, uniform-jitter, "
                                      "halton, sobol or cmj");
   return *pattern;
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
 }
 
 void print_errors(const std::map<std::string, ErrorSummary>& errors) {
