@@ -10,25 +10,18 @@
 #include <memory>
 #include <vector>
 
+#include "core/image/metrics.h"
 #include "core/render/probe.h"
 #include "core/scene/scene.h"
 
 namespace penumbra {
 namespace {
 
-// Least-squares slope of log(standard deviation) against log(N).
+// Least-squares slope of log(standard deviation) against log(N): half that of the variance.
 double std_dev_slope(const std::vector<int>& counts, const std::vector<ProbeRun>& runs) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  double n = double(counts.size());
-  for (size_t i = 0; i < counts.size(); ++i) {
-    double x = std::log(double(counts[i]));
-    double y = 0.5 * std::log(std::max(runs[i].variance.y, 1e-300));
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  std::vector<double> n(counts.begin(), counts.end()), variance;
+  for (const ProbeRun& run : runs) variance.push_back(run.variance.y);
+  return 0.5 * log_log_slope(n, variance);
 }
 
 TEST(LinesBillenDutre, Fig9StratifiedLinesConvergeFasterThanPoints) {

@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/image/metrics.h"
 #include "core/render/probe.h"
 #include "core/scene/scene.h"
 
@@ -44,16 +45,7 @@ std::vector<double> variances(std::shared_ptr<const Scene> scene, const ProbePoi
 
 // Least-squares slope of log(variance) against log(N).
 double slope(const std::vector<int>& counts, const std::vector<double>& variance) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  double n = double(counts.size());
-  for (size_t i = 0; i < counts.size(); ++i) {
-    double x = std::log(double(counts[i])), y = std::log(std::max(variance[i], 1e-300));
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  return log_log_slope(std::vector<double>(counts.begin(), counts.end()), variance);
 }
 
 TEST(LinesSalesinJarosz, Fig5MisOfTwoLineDirectionsBeatsTheirAverageAtEveryN) {
