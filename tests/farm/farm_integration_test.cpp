@@ -26,6 +26,8 @@ TEST(FarmIntegration, TwoWorkersRenderBitIdenticalToLocal) {
   auto worker_a = testing::start_worker(coordinator.address(), dir, "a");
   auto worker_b = testing::start_worker(coordinator.address(), dir, "b");
   FarmClient client(coordinator.address());
+  // Both at the coordinator before the job: 48 short tasks can end before a slow worker joins.
+  testing::wait_for_workers(client, 2);
   auto submitted = client.submit(testing::job_spec(scene, "sa", 16, 7));
   std::vector<v1::JobStatus> events;
   v1::JobStatus final_status = client.watch(

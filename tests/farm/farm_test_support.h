@@ -293,6 +293,18 @@ inline void expect_bit_identical(FarmClient& client, const std::string& job_id,
   EXPECT_EQ(metadata["penumbra:method"], method);
 }
 
+// Waits until `count` workers have registered (a job submitted earlier may be over before a
+// slow-starting worker joins); throws after `timeout`.
+inline void wait_for_workers(FarmClient& client, size_t count,
+                             std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (client.workers().size() < count) {
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error(std::to_string(count) + " workers did not register in time");
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
 inline v1::JobStatus wait_until(FarmClient& client, const std::string& job_id,
                                 const std::function<bool(const v1::JobStatus&)>& condition,
                                 std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
