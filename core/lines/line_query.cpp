@@ -101,63 +101,47 @@ Vec3 absolute(const Vec3& v) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Traversal. The node test needs, per query, a few linear functions f(p) = dot(gradient, p) +
-// offset over boxes: their value at a box's centre (`middle`) and a radius, so that
-// [middle - radius, middle + radius] contains the exact range of f over the box. The constants
-// are stored as floats, once: the AVX test broadcasts them from memory (one instruction), the
-// SSE test with a load and a shuffle.
+// Traversal. The node test needs, per query, three linear functions f(p) = dot(gradient, p) +
+// offset over boxes (the distance to the shadow plane, alpha and beta; see shadow_triangle.h):
+// their value at a box's centre (`middle`) and a radius, so that [middle - radius, middle +
+// radius] contains the exact range of f over the box. Their constants are floats, computed
+// once per query.
 
-inline __m128 sse(float value) {
-  return _mm_set1_ps(value);
-}
-
-// Three doubles rounded to float (as static_cast<float> does, lane by lane) in lanes 0-2.
-inline __m128 to_floats(const Vec3& v) {
-  return _mm_movelh_ps(_mm_cvtpd_ps(_mm_set_pd(v.y, v.x)), _mm_cvtpd_ps(_mm_set_sd(v.z)));
-}
-
-struct LinearFunction {
-  alignas(16) float gradient[4];   // lanes 0-2
-  alignas(16) float magnitude[4];  // |gradient|
-  float offset, error;
-
-  // `coordinate_bound` is max |p| over the scene plus |x|, per axis (computed once per query).
-  void set(const Vec3& gradient_d, const Vec3& x, const Vec3& coordinate_bound) {
-    // Float error of evaluating dot(g, c) + offset and dot(|g|, e) with g, offset, c, e rounded
-    // to float: a few ulps of the largest partial sum, bounded by |g|.(max |p| + |x|) since
-    // centres and extents are bounded by the scene's extent; 32 ulps to be safe.
-    error =
-        static_cast<float>(32 * (FLT_EPSILON / 2) * dot(absolute(gradient_d), coordinate_bound));
-    offset = static_cast<float>(-dot(gradient_d, x));
-    // |float(g)| == float(|g|) (rounding is symmetric): the magnitudes are the gradients with
-    // the sign bit cleared.
-    const __m128 rounded = to_floats(gradient_d);
-    _mm_store_ps(gradient, rounded);
-    _mm_store_ps(magnitude, _mm_andnot_ps(_mm_set1_ps(-0.0f), rounded));
-  }
-};
+// The three functions, in this order, in lanes 0-2 of the set-up's arrays.
+enum Function { kDistance = 0, kAlpha = 1, kBeta = 2 };
 
 // Everything the node test needs from one query.
 struct NodeTestSetup {
-  float region_lower[3], region_upper[3];  // bounding box of the crossing region
-  LinearFunction distance, alpha, beta;    // see shadow_triangle.h
+  float region_lower[4], region_upper[4];  // bounding box of the crossing region (lanes 0-2)
+  float gradient[3][4];                    // [axis][function]
+  float magnitude[3][4];                   // |gradient|
+  float offset[4], error[4];               // [function]
   // Depth s = alpha + beta: its range over a box lies within the sum of theirs, widened by
-  // depth_error (the rounding of the two extra sums; see visible_intervals).
+  // depth_error (the rounding of the two extra sums; see set_up_node_test).
   float depth_error;
   float s_min, s_max;
+
+  // Over the eight boxes (centre c, half extent e): the value of function f at the centre, and
+  // a radius such that [middle - radius, middle + radius] holds f over the box.
+  lanes::F8 middle(Function f, const lanes::F8 center[3]) const {
+    return (offset[f] + gradient[0][f] * center[0]) +
+           (gradient[1][f] * center[1] + gradient[2][f] * center[2]);
+  }
+  lanes::F8 radius(Function f, const lanes::F8 extent[3]) const {
+    return (error[f] + magnitude[0][f] * extent[0]) +
+           (magnitude[1][f] * extent[1] + magnitude[2][f] * extent[2]);
+  }
 };
 
 // What the node test returns for each surviving child: the t-range its box projects to on the
-// segment and the lower bound of its depth s (the near-to-far order).
+// segment.
 struct ChildRanges {
-  alignas(32) float t_lower[LineQuery::kWidth];
-  alignas(32) float t_upper[LineQuery::kWidth];
-  alignas(32) float depth_lower[LineQuery::kWidth];
+  float t_lower[LineQuery::kWidth];
+  float t_upper[LineQuery::kWidth];
 };
 
-// The node test, the same float operations in the same order per lane in both versions (no
-// fused multiply-add: the build has -ffp-contract=off and the AVX version does not enable
-// FMA), so they keep the same children. Ordered comparisons: NaN centres (empty slots) fail.
+// The node test: the eight child boxes at once (lanes.h: SSE2 halves or AVX, the same float
+// operations per lane either way). Ordered comparisons: NaN centres (empty slots) fail.
 //
 // Cheapest tests first: the child box against the crossing region's bounding box (the
 // triangle-box test's box-axis half, Akenine-Möller 2001) and against the shadow plane
@@ -168,176 +152,56 @@ struct ChildRanges {
 // t = beta / (alpha + beta) grows with beta and falls with alpha, so over the box's [alpha] x
 // [beta] rectangle its range is [beta_lo / (alpha_hi + beta_lo), beta_hi / (alpha_lo + beta_hi)]
 // with negative bounds clamped to 0. Returns the bit mask of the surviving children.
-using NodeTest = unsigned (*)(const LineQuery::Node& node, const NodeTestSetup& setup,
-                              ChildRanges& out);
-
-unsigned test_children_sse(const LineQuery::Node& node, const NodeTestSetup& setup,
-                           ChildRanges& out) {
-  const __m128 zero = _mm_setzero_ps();
-  const __m128 tiny = _mm_set1_ps(FLT_MIN);
-  const __m128 sign_bit = _mm_set1_ps(-0.0f);
-  auto middle_of = [](const LinearFunction& f, const __m128 center[3]) {
-    return _mm_add_ps(_mm_add_ps(sse(f.offset), _mm_mul_ps(sse(f.gradient[0]), center[0])),
-                      _mm_add_ps(_mm_mul_ps(sse(f.gradient[1]), center[1]),
-                                 _mm_mul_ps(sse(f.gradient[2]), center[2])));
-  };
-  auto radius_of = [](float error, const float magnitude[3], const __m128 extent[3]) {
-    return _mm_add_ps(_mm_add_ps(sse(error), _mm_mul_ps(sse(magnitude[0]), extent[0])),
-                      _mm_add_ps(_mm_mul_ps(sse(magnitude[1]), extent[1]),
-                                 _mm_mul_ps(sse(magnitude[2]), extent[2])));
-  };
-  unsigned result = 0;
-  for (int half = 0; half < LineQuery::kWidth; half += 4) {
-    const __m128 center[3] = {_mm_load_ps(node.center[0] + half),
-                              _mm_load_ps(node.center[1] + half),
-                              _mm_load_ps(node.center[2] + half)};
-    const __m128 extent[3] = {_mm_load_ps(node.extent[0] + half),
-                              _mm_load_ps(node.extent[1] + half),
-                              _mm_load_ps(node.extent[2] + half)};
-    __m128 keep = _mm_cmple_ps(_mm_sub_ps(center[0], extent[0]), sse(setup.region_upper[0]));
-    keep = _mm_and_ps(keep,
-                      _mm_cmpge_ps(_mm_add_ps(center[0], extent[0]), sse(setup.region_lower[0])));
-    for (int k = 1; k < 3; ++k) {
-      keep = _mm_and_ps(keep,
-                        _mm_cmple_ps(_mm_sub_ps(center[k], extent[k]), sse(setup.region_upper[k])));
-      keep = _mm_and_ps(keep,
-                        _mm_cmpge_ps(_mm_add_ps(center[k], extent[k]), sse(setup.region_lower[k])));
-    }
-    if (_mm_movemask_ps(keep) == 0) continue;
-    const __m128 distance_middle = middle_of(setup.distance, center);
-    const __m128 distance_radius =
-        radius_of(setup.distance.error, setup.distance.magnitude, extent);
-    keep =
-        _mm_and_ps(keep, _mm_cmple_ps(_mm_andnot_ps(sign_bit, distance_middle), distance_radius));
-    if (_mm_movemask_ps(keep) == 0) continue;
-
-    const __m128 alpha_middle = middle_of(setup.alpha, center);
-    const __m128 alpha_radius = radius_of(setup.alpha.error, setup.alpha.magnitude, extent);
-    const __m128 beta_middle = middle_of(setup.beta, center);
-    const __m128 beta_radius = radius_of(setup.beta.error, setup.beta.magnitude, extent);
-    const __m128 depth_middle = _mm_add_ps(alpha_middle, beta_middle);
-    const __m128 depth_radius =
-        _mm_add_ps(_mm_add_ps(alpha_radius, beta_radius), sse(setup.depth_error));
-    const __m128 alpha_lower = _mm_sub_ps(alpha_middle, alpha_radius);
-    const __m128 alpha_upper = _mm_add_ps(alpha_middle, alpha_radius);
-    const __m128 beta_lower = _mm_sub_ps(beta_middle, beta_radius);
-    const __m128 beta_upper = _mm_add_ps(beta_middle, beta_radius);
-    const __m128 depth_lower = _mm_sub_ps(depth_middle, depth_radius);
-    const __m128 depth_upper = _mm_add_ps(depth_middle, depth_radius);
-    keep = _mm_and_ps(keep, _mm_cmpge_ps(alpha_upper, zero));
-    keep = _mm_and_ps(keep, _mm_cmpge_ps(beta_upper, zero));
-    keep = _mm_and_ps(keep, _mm_cmpgt_ps(depth_upper, sse(setup.s_min)));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(depth_lower, sse(setup.s_max)));
-    const unsigned mask = static_cast<unsigned>(_mm_movemask_ps(keep));
-    if (mask == 0) continue;
-
-    const __m128 beta_lower_clamped = _mm_max_ps(beta_lower, zero);
-    const __m128 alpha_lower_clamped = _mm_max_ps(alpha_lower, zero);
-    _mm_store_ps(out.t_lower + half,
-                 _mm_div_ps(beta_lower_clamped,
-                            _mm_max_ps(_mm_add_ps(alpha_upper, beta_lower_clamped), tiny)));
-    _mm_store_ps(
-        out.t_upper + half,
-        _mm_div_ps(beta_upper, _mm_max_ps(_mm_add_ps(alpha_lower_clamped, beta_upper), tiny)));
-    _mm_store_ps(out.depth_lower + half, depth_lower);
-    result |= mask << half;
-  }
-  return result;
-}
-
-#if defined(__x86_64__) || defined(__i386__)
-#define PENUMBRA_LINE_QUERY_AVX 1
-#define PENUMBRA_AVX __attribute__((target("avx"), always_inline)) inline
-
-// AVX helpers of the node test (lambdas would not inherit the target attribute).
-PENUMBRA_AVX __m256 lanes(const float& value) {
-  return _mm256_broadcast_ss(&value);
-}
-PENUMBRA_AVX __m256 middle_of(const LinearFunction& f, const __m256 center[3]) {
-  return _mm256_add_ps(
-      _mm256_add_ps(lanes(f.offset), _mm256_mul_ps(lanes(f.gradient[0]), center[0])),
-      _mm256_add_ps(_mm256_mul_ps(lanes(f.gradient[1]), center[1]),
-                    _mm256_mul_ps(lanes(f.gradient[2]), center[2])));
-}
-PENUMBRA_AVX __m256 radius_of(const float& error, const float magnitude[3],
-                              const __m256 extent[3]) {
-  return _mm256_add_ps(_mm256_add_ps(lanes(error), _mm256_mul_ps(lanes(magnitude[0]), extent[0])),
-                       _mm256_add_ps(_mm256_mul_ps(lanes(magnitude[1]), extent[1]),
-                                     _mm256_mul_ps(lanes(magnitude[2]), extent[2])));
-}
-
-// The same test on all eight children at once (AVX, 256-bit; selected at run time).
-__attribute__((target("avx"))) unsigned test_children_avx(const LineQuery::Node& node,
-                                                          const NodeTestSetup& setup,
-                                                          ChildRanges& out) {
-  static_assert(LineQuery::kWidth == 8, "the AVX node test handles eight children");
-  const __m256 zero = _mm256_setzero_ps();
-  const __m256 tiny = _mm256_set1_ps(FLT_MIN);
-  const __m256 sign_bit = _mm256_set1_ps(-0.0f);
-  const __m256 center[3] = {_mm256_load_ps(node.center[0]), _mm256_load_ps(node.center[1]),
-                            _mm256_load_ps(node.center[2])};
-  const __m256 extent[3] = {_mm256_load_ps(node.extent[0]), _mm256_load_ps(node.extent[1]),
-                            _mm256_load_ps(node.extent[2])};
-  __m256 keep =
-      _mm256_cmp_ps(_mm256_sub_ps(center[0], extent[0]), lanes(setup.region_upper[0]), _CMP_LE_OQ);
-  keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_add_ps(center[0], extent[0]),
-                                           lanes(setup.region_lower[0]), _CMP_GE_OQ));
+template <class Mask>
+inline unsigned test_children(const LineQuery::Node& node, const NodeTestSetup& setup,
+                              ChildRanges& out) {
+  using lanes::F8;
+  using lanes::I8;
+  const F8 center[3] = {lanes::load(node.center[0]), lanes::load(node.center[1]),
+                        lanes::load(node.center[2])};
+  const F8 extent[3] = {lanes::load(node.extent[0]), lanes::load(node.extent[1]),
+                        lanes::load(node.extent[2])};
+  I8 keep = (center[0] - extent[0] <= setup.region_upper[0]) &
+            (center[0] + extent[0] >= setup.region_lower[0]);
   for (int k = 1; k < 3; ++k) {
-    keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_sub_ps(center[k], extent[k]),
-                                             lanes(setup.region_upper[k]), _CMP_LE_OQ));
-    keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_add_ps(center[k], extent[k]),
-                                             lanes(setup.region_lower[k]), _CMP_GE_OQ));
+    keep &= center[k] - extent[k] <= setup.region_upper[k];
+    keep &= center[k] + extent[k] >= setup.region_lower[k];
   }
-  if (_mm256_movemask_ps(keep) == 0) return 0;
-  const __m256 distance_middle = middle_of(setup.distance, center);
-  const __m256 distance_radius = radius_of(setup.distance.error, setup.distance.magnitude, extent);
-  keep = _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_andnot_ps(sign_bit, distance_middle),
-                                           distance_radius, _CMP_LE_OQ));
-  if (_mm256_movemask_ps(keep) == 0) return 0;
+  if (Mask::of(keep) == 0) return 0;
+  keep &= lanes::absolute(setup.middle(kDistance, center)) <= setup.radius(kDistance, extent);
+  if (Mask::of(keep) == 0) return 0;
 
-  const __m256 alpha_middle = middle_of(setup.alpha, center);
-  const __m256 alpha_radius = radius_of(setup.alpha.error, setup.alpha.magnitude, extent);
-  const __m256 beta_middle = middle_of(setup.beta, center);
-  const __m256 beta_radius = radius_of(setup.beta.error, setup.beta.magnitude, extent);
-  const __m256 depth_middle = _mm256_add_ps(alpha_middle, beta_middle);
-  const __m256 depth_radius =
-      _mm256_add_ps(_mm256_add_ps(alpha_radius, beta_radius), lanes(setup.depth_error));
-  const __m256 alpha_lower = _mm256_sub_ps(alpha_middle, alpha_radius);
-  const __m256 alpha_upper = _mm256_add_ps(alpha_middle, alpha_radius);
-  const __m256 beta_lower = _mm256_sub_ps(beta_middle, beta_radius);
-  const __m256 beta_upper = _mm256_add_ps(beta_middle, beta_radius);
-  const __m256 depth_lower = _mm256_sub_ps(depth_middle, depth_radius);
-  const __m256 depth_upper = _mm256_add_ps(depth_middle, depth_radius);
-  keep = _mm256_and_ps(keep, _mm256_cmp_ps(alpha_upper, zero, _CMP_GE_OQ));
-  keep = _mm256_and_ps(keep, _mm256_cmp_ps(beta_upper, zero, _CMP_GE_OQ));
-  keep = _mm256_and_ps(keep, _mm256_cmp_ps(depth_upper, lanes(setup.s_min), _CMP_GT_OQ));
-  keep = _mm256_and_ps(keep, _mm256_cmp_ps(depth_lower, lanes(setup.s_max), _CMP_LT_OQ));
-  const unsigned mask = static_cast<unsigned>(_mm256_movemask_ps(keep));
+  const F8 alpha_middle = setup.middle(kAlpha, center);
+  const F8 alpha_radius = setup.radius(kAlpha, extent);
+  const F8 beta_middle = setup.middle(kBeta, center);
+  const F8 beta_radius = setup.radius(kBeta, extent);
+  const F8 depth_middle = alpha_middle + beta_middle;
+  const F8 depth_radius = (alpha_radius + beta_radius) + setup.depth_error;
+  const F8 alpha_lower = alpha_middle - alpha_radius;
+  const F8 alpha_upper = alpha_middle + alpha_radius;
+  const F8 beta_lower = beta_middle - beta_radius;
+  const F8 beta_upper = beta_middle + beta_radius;
+  const F8 depth_lower = depth_middle - depth_radius;
+  const F8 depth_upper = depth_middle + depth_radius;
+  keep &= alpha_upper >= 0.0f;
+  keep &= beta_upper >= 0.0f;
+  keep &= depth_upper > setup.s_min;
+  keep &= depth_lower < setup.s_max;
+  const unsigned mask = Mask::of(keep);
   if (mask == 0) return 0;
 
-  const __m256 beta_lower_clamped = _mm256_max_ps(beta_lower, zero);
-  const __m256 alpha_lower_clamped = _mm256_max_ps(alpha_lower, zero);
-  _mm256_store_ps(
-      out.t_lower,
-      _mm256_div_ps(beta_lower_clamped,
-                    _mm256_max_ps(_mm256_add_ps(alpha_upper, beta_lower_clamped), tiny)));
-  _mm256_store_ps(
-      out.t_upper,
-      _mm256_div_ps(beta_upper,
-                    _mm256_max_ps(_mm256_add_ps(alpha_lower_clamped, beta_upper), tiny)));
-  _mm256_store_ps(out.depth_lower, depth_lower);
+  const F8 zero = {};
+  const F8 tiny = zero + FLT_MIN;
+  const F8 beta_lower_clamped = lanes::maximum(beta_lower, zero);
+  const F8 alpha_lower_clamped = lanes::maximum(alpha_lower, zero);
+  lanes::store(out.t_lower,
+               beta_lower_clamped / lanes::maximum(alpha_upper + beta_lower_clamped, tiny));
+  lanes::store(out.t_upper, beta_upper / lanes::maximum(alpha_lower_clamped + beta_upper, tiny));
   return mask;
 }
-#endif
-
-#ifdef PENUMBRA_LINE_QUERY_AVX
-constexpr NodeTest node_test_avx = test_children_avx;
-#else
-constexpr NodeTest node_test_avx = test_children_sse;
-#endif
 
 bool cpu_has_avx() {
-#ifdef PENUMBRA_LINE_QUERY_AVX
+#if defined(__x86_64__) || defined(__i386__)
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx");
 #else
@@ -345,16 +209,203 @@ bool cpu_has_avx() {
 #endif
 }
 
-// Stack entry: a node or leaf code with the t-range its box projects to (re-checked when popped,
-// since cuts found in the meantime may have covered it).
-struct StackEntry {
-  uint32_t code;
-  float t_lower, t_upper;
+// The traversal stack: node or leaf codes with the t-range each one's box projects to
+// (re-checked when popped, since cuts found in the meantime may have covered it). One array per
+// field, so that every pop reads exactly what one push wrote (a load spanning two stores would
+// wait for them to reach the cache, on every node).
+constexpr int kStackCapacity = 256;  // kWidth - 1 entries per level: depth checked at build
+struct TraversalStack {
+  uint32_t code[kStackCapacity];
+  float t_lower[kStackCapacity], t_upper[kStackCapacity];
+  int top = 0;
+
+  void push(uint32_t node, float lower, float upper) {
+    code[top] = node;
+    t_lower[top] = lower;
+    t_upper[top] = upper;
+    ++top;
+  }
+  bool empty() const { return top == 0; }
 };
 
 // Slack on projected t-ranges (t is in [0,1]): float rounding of one add and one divide.
 constexpr float kProjectionSlack = 1e-6f;
-constexpr int kStackCapacity = 256;  // kWidth - 1 entries per level: depth checked at build
+
+// What a query reads of the built structure.
+struct Traversal {
+  const LineQuery::Node* nodes;
+  const OccluderTriangle* triangles;  // in leaf order
+  bool empty;                         // no occluders
+  bool prefetch;       // nodes and triangles exceed a typical L2 cache: prefetch children
+  Vec3 scene_max_abs;  // per axis, the largest |coordinate| (float error bounds)
+  ShadowTriangleTolerances tolerances;
+};
+
+// 2^-e for the e with 2^e <= value < 2^(e + 1): a scale that brings `value` into [1, 2) exactly.
+// For finite positive values whose scale is a normal double (every non-degenerate shadow
+// triangle's normal); otherwise 1 / value, which rounds.
+inline double unit_scale(double value) {
+  uint64_t bits;
+  __builtin_memcpy(&bits, &value, sizeof bits);
+  const int64_t exponent = static_cast<int64_t>(bits >> 52);  // biased; sign bit clear
+  if (exponent < 1 || exponent > 2045) return 1 / value;
+  const uint64_t scale_bits = static_cast<uint64_t>(2046 - exponent) << 52;
+  double scale;
+  __builtin_memcpy(&scale, &scale_bits, sizeof scale);
+  return scale;
+}
+
+// The node test's constants for one shadow triangle: double, rounded to float. (Scalar code:
+// each value is written once and read back only as the float it was stored as.)
+inline void set_up_node_test(const ShadowTriangle& shadow, const Vec3& scene_max_abs,
+                             NodeTestSetup& setup) {
+  const Vec3& x = shadow.x;
+  // The plane test is homogeneous in the normal: scaled by a power of two to a largest
+  // component in [1, 2) (exact, and far from float denormals, which flush to zero, at any
+  // scene scale).
+  const Vec3 n = shadow.plane_normal * unit_scale(max_component(absolute(shadow.plane_normal)));
+  const Vec3* const gradients[3] = {&n, &shadow.alpha_gradient, &shadow.beta_gradient};
+  // Float error of evaluating dot(g, c) + offset and dot(|g|, e) with g, offset, c, e rounded to
+  // float: a few ulps of the largest partial sum, bounded by |g|.(max |p| + |x|) since centres
+  // and extents are bounded by the scene's extent; 32 ulps to be safe. (Double rounding here is
+  // far below that margin.)
+  const Vec3 bound = scene_max_abs + absolute(x);
+  for (int f = 0; f < 3; ++f) {
+    const Vec3& g = *gradients[f];
+    setup.offset[f] = static_cast<float>(-dot(g, x));  // f(p) = dot(g, p) - dot(g, x)
+    setup.error[f] = static_cast<float>(32 * (FLT_EPSILON / 2) * dot(absolute(g), bound));
+    for (int axis = 0; axis < 3; ++axis) {
+      setup.gradient[axis][f] = static_cast<float>(g[axis]);
+      // |float(g)| == float(|g|) (rounding is symmetric).
+      setup.magnitude[axis][f] = std::fabs(setup.gradient[axis][f]);
+    }
+  }
+  // Depth s = alpha + beta over a box: within [alpha] + [beta] (each radius already holds its
+  // own error bound), i.e. middle alpha_m + beta_m, radius alpha_r + beta_r. The two extra float
+  // sums round by at most an ulp of (|g_alpha| + |g_beta|).(max |p| + |x|), far below the sum of
+  // the two 32-ulp error terms added here.
+  setup.depth_error = setup.error[kAlpha] + setup.error[kBeta];
+  setup.s_min = static_cast<float>(shadow.s_min);
+  setup.s_max = static_cast<float>(shadow.s_max);
+  // The bounding box of the part of the shadow triangle that can hold a crossing: depth s in
+  // [s_min, s_max], the quadrilateral x + s (a - x), x + s (b - x). Box against box is the
+  // triangle-box test's box-axis half (Akenine-Möller 2001); with the free zone near x left
+  // out, it also drops the surface x lies on before its leaf is reached. Rounded outwards.
+  for (int k = 0; k < 3; ++k) {
+    // Per axis the corners are x + s v with s in {s_min, s_max} (both > 0) and v in
+    // {to_a, to_b}: the extremes take s_max where v is on the far side of 0.
+    const double v_lower = std::min(shadow.to_a[k], shadow.to_b[k]);
+    const double v_upper = std::max(shadow.to_a[k], shadow.to_b[k]);
+    const double lower = x[k] + (v_lower < 0 ? shadow.s_max : shadow.s_min) * v_lower;
+    const double upper = x[k] + (v_upper > 0 ? shadow.s_max : shadow.s_min) * v_upper;
+    // Rounding of the corners (double) and to float (half an ulp): 1e-6 of the coordinates
+    // involved covers both.
+    const double slack = 1e-6 * (std::fabs(x[k]) + std::fabs(lower) + std::fabs(upper));
+    setup.region_lower[k] = static_cast<float>(lower - slack);
+    setup.region_upper[k] = static_cast<float>(upper + slack);
+  }
+}
+
+// The walk: nodes tested eight children at a time, surviving children pushed nearest first,
+// exact crossings at the leaves. Inlined whole into traverse_sse and traverse_avx (below), so
+// that the node test and occluder_cut are compiled for each instruction set and the query's
+// constants stay in registers.
+// Returns false, with `out` untouched, when the shadow triangle is degenerate (the caller
+// answers those with a shadow ray).
+template <class Mask>
+inline bool query(const Traversal& traversal, const Vec3& x, const Vec3& a, const Vec3& b,
+                  IntervalList& out, LineQueryStats* stats) {
+  ShadowTriangle shadow;
+  if (!shadow.set(x, a, b, traversal.tolerances)) return false;
+  if (traversal.empty) return true;
+  NodeTestSetup setup;
+  set_up_node_test(shadow, traversal.scene_max_abs, setup);
+
+  TraversalStack stack;
+  stack.push(0, 0.0f, 1.0f);
+  uint64_t nodes_visited = 0, triangles_tested = 0, cuts = 0;
+  ChildRanges ranges;
+
+  while (!stack.empty()) {
+    const int top = --stack.top;
+    const uint32_t code = stack.code[top];
+    // Skip what cuts found since the push have covered. (Before the first cut the whole
+    // segment is visible and every pushed range, within [0,1], overlaps it.)
+    if (cuts != 0 &&
+        !out.overlaps(stack.t_lower[top] - kProjectionSlack, stack.t_upper[top] + kProjectionSlack))
+      continue;
+
+    if (code & LineQuery::kLeafFlag) {
+      // Leaf: exact crossings in double.
+      const uint32_t first = (code & ~LineQuery::kLeafFlag) >> LineQuery::kCountBits;
+      const uint32_t count = (code & ((1u << LineQuery::kCountBits) - 1)) + 1;
+      for (uint32_t i = first; i < first + count; ++i) {
+        ++triangles_tested;
+        const std::optional<Interval> cut = occluder_cut(shadow, traversal.triangles[i]);
+        if (!cut) continue;
+        ++cuts;
+        out.subtract(cut->lo, cut->hi);
+        if (out.fully_occluded()) {
+          stack.top = 0;  // nothing stays visible: done
+          break;
+        }
+      }
+      continue;
+    }
+
+    const LineQuery::Node& node = traversal.nodes[code];
+    ++nodes_visited;
+    unsigned mask = test_children<Mask>(node, setup, ranges);
+    // Push the surviving children, the lowest slot last so that it is popped first. (Whether
+    // their projection is already occluded is checked when they are popped. Sorting them by
+    // depth, nearest first, measured no fewer triangle tests and cuts on the bundled scenes,
+    // and cost instructions and mispredicted branches.)
+    while (mask != 0) {
+      const int slot = 31 - __builtin_clz(mask);
+      mask ^= 1u << slot;
+      const uint32_t child = node.child[slot];
+      stack.push(child, ranges.t_lower[slot], ranges.t_upper[slot]);
+      // Start loading it now: the walk is bound by memory on large scenes (small ones stay in
+      // cache, and the prefetches would only cost instructions).
+      if (!traversal.prefetch) continue;
+      if (child & LineQuery::kLeafFlag) {
+        const char* leaf = reinterpret_cast<const char*>(
+            &traversal.triangles[(child & ~LineQuery::kLeafFlag) >> LineQuery::kCountBits]);
+        _mm_prefetch(leaf, _MM_HINT_T0);
+        _mm_prefetch(leaf + 64, _MM_HINT_T0);
+      } else {
+        const char* next = reinterpret_cast<const char*>(&traversal.nodes[child]);
+        for (size_t line = 0; line < sizeof(LineQuery::Node); line += 64)
+          _mm_prefetch(next + line, _MM_HINT_T0);
+      }
+    }
+  }
+  if (stats) {
+    stats->nodes_visited += nodes_visited;
+    stats->triangles_tested += triangles_tested;
+    stats->cuts += cuts;
+  }
+  return true;
+}
+
+// The two builds of the walk (flatten: everything it calls is inlined and compiled with its
+// instruction set). Both do the same IEEE operations per lane: the same answers, bit for bit.
+__attribute__((flatten)) bool query_sse(const Traversal& traversal, const Vec3& x, const Vec3& a,
+                                        const Vec3& b, IntervalList& out, LineQueryStats* stats) {
+  return query<lanes::SseMask>(traversal, x, a, b, out, stats);
+}
+#if defined(__x86_64__) || defined(__i386__)
+__attribute__((target("avx"), flatten)) bool query_avx(const Traversal& traversal, const Vec3& x,
+                                                       const Vec3& a, const Vec3& b,
+                                                       IntervalList& out, LineQueryStats* stats) {
+  return query<lanes::AvxMask>(traversal, x, a, b, out, stats);
+}
+#else
+bool query_avx(const Traversal& traversal, const Vec3& x, const Vec3& a, const Vec3& b,
+               IntervalList& out, LineQueryStats* stats) {
+  return query_sse(traversal, x, a, b, out, stats);
+}
+#endif
 
 }  // namespace
 
@@ -546,128 +597,14 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
 void LineQuery::visible_intervals(const Vec3& x, const Vec3& a, const Vec3& b, IntervalList& out,
                                   LineQueryStats* stats) const {
   out.reset();
-  std::optional<ShadowTriangle> shadow = ShadowTriangle::make(x, a, b, options_.tolerances);
-  if (!shadow) {
-    // Non-finite input: nothing visible. Degenerate shadow triangle: the segment is seen along
-    // one direction, one shadow ray decides.
-    if (!is_finite(x) || !is_finite(a) || !is_finite(b) || occluded(x, 0.5 * (a + b))) out.clear();
-    return;
-  }
-  if (nodes_.empty()) return;
-
-  // The shadow triangle's planes as linear functions over boxes (see shadow_triangle.h):
-  // distance to the plane, alpha, beta and depth s = alpha + beta.
-  // (The plane test is homogeneous in the normal: normalized, so that it stays far from float
-  // denormals, which flush to zero, at any scene scale.)
-  // One bound for all four error terms (|g|.(max |p| + |x|); double rounding of the sum is far
-  // below the 32-ulp float margin).
-  const Vec3 coordinate_bound = scene_max_abs_ + absolute(x);
-  NodeTestSetup setup;
-  setup.distance.set(normalize(shadow->plane_normal), x, coordinate_bound);
-  setup.alpha.set(shadow->alpha_gradient, x, coordinate_bound);
-  setup.beta.set(shadow->beta_gradient, x, coordinate_bound);
-  // Depth s = alpha + beta over a box: within [alpha] + [beta] (each radius already holds its
-  // own error bound), i.e. middle alpha_m + beta_m, radius alpha_r + beta_r. The two extra float
-  // sums round by at most an ulp of (|g_alpha| + |g_beta|).(max |p| + |x|), far below the sum of
-  // the two 32-ulp error terms added here.
-  setup.depth_error = setup.alpha.error + setup.beta.error;
-  setup.s_min = static_cast<float>(shadow->s_min);
-  setup.s_max = static_cast<float>(shadow->s_max);
-  // The bounding box of the part of the shadow triangle that can hold a crossing: depth s in
-  // [s_min, s_max], the quadrilateral x + s (a - x), x + s (b - x). Box against box is the
-  // triangle-box test's box-axis half (Akenine-Möller 2001); with the free zone near x left
-  // out, it also drops the surface x lies on before its leaf is reached. Rounded outwards.
-  for (int k = 0; k < 3; ++k) {
-    // Per axis the corners are x + s v with s in {s_min, s_max} (both > 0) and v in
-    // {to_a, to_b}: the extremes take s_max where v is on the far side of 0.
-    const double v_lower = std::min(shadow->to_a[k], shadow->to_b[k]);
-    const double v_upper = std::max(shadow->to_a[k], shadow->to_b[k]);
-    const double lower = x[k] + (v_lower < 0 ? shadow->s_max : shadow->s_min) * v_lower;
-    const double upper = x[k] + (v_upper > 0 ? shadow->s_max : shadow->s_min) * v_upper;
-    // Rounding of the corners (double) and to float (half an ulp): 1e-6 of the coordinates
-    // involved covers both.
-    const double slack = 1e-6 * (std::fabs(x[k]) + std::fabs(lower) + std::fabs(upper));
-    setup.region_lower[k] = static_cast<float>(lower - slack);
-    setup.region_upper[k] = static_cast<float>(upper + slack);
-  }
-  const NodeTest test_children = use_avx_ ? node_test_avx : test_children_sse;
-
-  const bool prefetch = prefetch_;
-  StackEntry stack[kStackCapacity];
-  int top = 0;
-  stack[top++] = {0, 0.0f, 1.0f};
-  uint64_t nodes_visited = 0, triangles_tested = 0, cuts = 0;
-  ChildRanges ranges;
-
-  while (top > 0) {
-    const StackEntry entry = stack[--top];
-    // Skip what cuts found since the push have covered. (Before the first cut the whole
-    // segment is visible and every pushed range, within [0,1], overlaps it.)
-    if (cuts != 0 &&
-        !out.overlaps(entry.t_lower - kProjectionSlack, entry.t_upper + kProjectionSlack))
-      continue;
-
-    if (entry.code & kLeafFlag) {
-      // Leaf: exact crossings in double.
-      uint32_t first = (entry.code & ~kLeafFlag) >> kCountBits;
-      uint32_t count = (entry.code & ((1u << kCountBits) - 1)) + 1;
-      for (uint32_t i = first; i < first + count; ++i) {
-        ++triangles_tested;
-        std::optional<Interval> cut = occluder_cut(*shadow, triangles_[i]);
-        if (!cut) continue;
-        ++cuts;
-        out.subtract(cut->lo, cut->hi);
-        if (out.fully_occluded()) {
-          top = 0;  // nothing stays visible: done
-          break;
-        }
-      }
-      continue;
-    }
-
-    const Node& node = nodes_[entry.code];
-    ++nodes_visited;
-    unsigned mask = test_children(node, setup, ranges);
-    if (mask == 0) continue;
-
-    // Surviving children, nearest to x first. (Whether their projection is already occluded
-    // is checked when they are popped.)
-    int order[kWidth];
-    int kept = 0;
-    for (; mask != 0; mask &= mask - 1) {
-      const int slot = __builtin_ctz(mask);
-      int position = kept++;
-      while (position > 0 && ranges.depth_lower[order[position - 1]] > ranges.depth_lower[slot]) {
-        order[position] = order[position - 1];
-        --position;
-      }
-      order[position] = slot;
-    }
-    // Push far to near so the nearest is popped first.
-    for (int i = kept - 1; i >= 0; --i) {
-      const int slot = order[i];
-      const uint32_t code = node.child[slot];
-      stack[top++] = {code, ranges.t_lower[slot], ranges.t_upper[slot]};
-      // Start loading it now: the walk is bound by memory on large scenes (small ones stay in
-      // cache, and the prefetches would only cost instructions).
-      if (!prefetch) continue;
-      if (code & kLeafFlag) {
-        const char* leaf =
-            reinterpret_cast<const char*>(&triangles_[(code & ~kLeafFlag) >> kCountBits]);
-        _mm_prefetch(leaf, _MM_HINT_T0);
-        _mm_prefetch(leaf + 64, _MM_HINT_T0);
-      } else {
-        const char* child = reinterpret_cast<const char*>(&nodes_[code]);
-        for (size_t line = 0; line < sizeof(Node); line += 64)
-          _mm_prefetch(child + line, _MM_HINT_T0);
-      }
-    }
-  }
-  if (stats) {
-    stats->nodes_visited += nodes_visited;
-    stats->triangles_tested += triangles_tested;
-    stats->cuts += cuts;
-  }
+  const Traversal traversal{nodes_.data(), triangles_.data(), nodes_.empty(),
+                            prefetch_,     scene_max_abs_,    options_.tolerances};
+  const bool answered = use_avx_ ? query_avx(traversal, x, a, b, out, stats)
+                                 : query_sse(traversal, x, a, b, out, stats);
+  if (answered) return;
+  // Non-finite input: nothing visible. Degenerate shadow triangle: the segment is seen along
+  // one direction, one shadow ray decides.
+  if (!is_finite(x) || !is_finite(a) || !is_finite(b) || occluded(x, 0.5 * (a + b))) out.clear();
 }
 
 bool LineQuery::occluded(const Vec3& x, const Vec3& p) const {

@@ -7,17 +7,17 @@
 //   our own node callbacks, then flattened into one array of nodes with float boxes stored
 //   structure-of-arrays, and leaf triangles stored contiguously in leaf order (float vertices
 //   in canonical order, OccluderTriangle);
-// - our own traversal: the eight child boxes of a node are tested together (AVX when the CPU
-//   has it, chosen at run time; otherwise two SSE halves doing the same float operations per
-//   lane, so both paths make the same decisions bit for bit) against the
-//   shadow triangle's plane, its three side planes, the self-occlusion plane near x and the
-//   bounding box of the region that can hold a crossing, with a conservative float error
-//   bound; each surviving child's box is projected from x onto the segment and skipped when
-//   that t-range is already occluded (checked when it is popped); children are visited
-//   nearest to x first (near occluders cut the most); the query stops as soon as nothing
-//   stays visible;
-// - exact double-precision crossings at the leaves (core/lines/shadow_triangle.h), watertight
-//   at shared edges, so the result equals visible_intervals_brute_force.
+// - our own traversal, written once with GCC vector extensions (core/lines/lanes.h) and
+//   compiled twice, for SSE2 and for AVX (chosen at run time; the same IEEE operations per
+//   lane, so both make the same decisions bit for bit): the eight child boxes of a node are
+//   tested together against the bounding box of the region that can hold a crossing, the
+//   shadow triangle's plane, its side planes through x, the plane through the segment and
+//   the self-occlusion plane near x, with a conservative float error bound; each surviving
+//   child's box is projected from x onto the segment and skipped when that t-range is already
+//   occluded (checked when it is popped); the query stops as soon as nothing stays visible;
+// - exact double-precision crossings at the leaves (core/lines/shadow_triangle.h, inlined
+//   into both builds), watertight at shared edges, so the result equals
+//   visible_intervals_brute_force.
 //
 // Thread safety: a built LineQuery is immutable; queries from many threads are fine.
 
@@ -39,8 +39,8 @@ struct LineQueryOptions {
   // Embree's SAH builder quality. HIGH runs without spatial splits (no split callback).
   LineQueryBuildQuality build_quality = LineQueryBuildQuality::Medium;
   unsigned max_leaf_size = 4;  // triangles per leaf
-  // Test nodes with AVX when the CPU has it. The SSE path computes the same floats lane by lane
-  // (tests compare both): results and culling do not depend on it, only speed.
+  // Run the traversal's AVX build when the CPU has AVX. The SSE2 build computes the same values
+  // lane by lane (tests compare both): results and culling do not depend on it, only speed.
   bool allow_avx = true;
 };
 
@@ -86,7 +86,7 @@ class LineQuery {
     float extent[3][kWidth];  // [axis][child], >= 0
     uint32_t child[kWidth];   // inner node index, or kLeafFlag | first << kCountBits | count - 1
   };
-  // True when queries test nodes with AVX (options().allow_avx and the CPU has AVX).
+  // True when queries run the AVX build (options().allow_avx and the CPU has AVX).
   bool uses_avx() const { return use_avx_; }
   static constexpr uint32_t kLeafFlag = 0x80000000u;
   static constexpr uint32_t kCountBits = 5;  // up to 32 triangles per leaf
