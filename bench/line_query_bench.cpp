@@ -453,6 +453,10 @@ int main(int argc, char** argv) {
                                        [name](benchmark::State& state) {
                                          line_queries(state, name, LineQueryBuildQuality::Medium);
                                        }));
+      fix(benchmark::RegisterBenchmark(("line_query_high/" + name).c_str(),
+                                       [name](benchmark::State& state) {
+                                         line_queries(state, name, LineQueryBuildQuality::High);
+                                       }));
     }
   }
   benchmark::Initialize(&argc, argv);

@@ -55,9 +55,12 @@ void set_bounds(void* node, const RTCBounds** bounds, unsigned int child_count, 
   for (unsigned i = 0; i < child_count; ++i) inner->bounds[i] = *bounds[i];
 }
 
-// Set from Embree's build threads when a leaf is larger than asked (Embree promises not to).
+// What the callbacks share: the triangles (for spatial splits) and a flag set from Embree's
+// build threads when a leaf is larger than asked (Embree promises not to).
 struct BuildStatus {
   std::atomic<bool> oversized_leaf{false};
+  const std::vector<OccluderTriangle>* occluders = nullptr;
+  double build_scale = 1;  // primitive boxes are the triangles' boxes times this power of two
 };
 
 void* create_leaf(RTCThreadLocalAllocator allocator, const RTCBuildPrimitive* primitives,
@@ -83,6 +86,74 @@ float round_up(double value) {
   float f = static_cast<float>(value);
   return static_cast<double>(f) < value ? std::nextafter(f, std::numeric_limits<float>::infinity())
                                         : f;
+}
+
+// Spatial splits (SBVH, HIGH quality): the boxes of the parts of a triangle on either side of
+// the plane coordinate[dimension] = position, within the box of the primitive (itself perhaps a
+// part of the triangle already). The parts' corners are the triangle's vertices on that side
+// and its edges' crossings with the plane, computed in double and rounded outwards, so each
+// box holds its part of the triangle: the node tests stay conservative.
+void split_primitive(const RTCBuildPrimitive* primitive, unsigned int dimension, float position,
+                     RTCBounds* left_bounds, RTCBounds* right_bounds, void* user) {
+  const auto* status = static_cast<const BuildStatus*>(user);
+  const OccluderTriangle& triangle = (*status->occluders)[primitive->primID];
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double v[3][3];
+  for (int k = 0; k < 3; ++k)
+    for (int axis = 0; axis < 3; ++axis)
+      v[k][axis] = static_cast<double>(triangle.coordinate[axis][k]) * status->build_scale;
+  double lower[2][3], upper[2][3];  // [side][axis]: side 0 below the plane, 1 above
+  for (int side = 0; side < 2; ++side)
+    for (int axis = 0; axis < 3; ++axis) {
+      lower[side][axis] = kInfinity;
+      upper[side][axis] = -kInfinity;
+    }
+  auto add = [&](int side, const double point[3]) {
+    for (int axis = 0; axis < 3; ++axis) {
+      lower[side][axis] = std::min(lower[side][axis], point[axis]);
+      upper[side][axis] = std::max(upper[side][axis], point[axis]);
+    }
+  };
+  const double plane = position;
+  for (int k = 0; k < 3; ++k) {
+    if (v[k][dimension] <= plane) add(0, v[k]);
+    if (v[k][dimension] >= plane) add(1, v[k]);
+  }
+  static constexpr int kEdges[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (const auto& edge : kEdges) {
+    const double* p = v[edge[0]];
+    const double* q = v[edge[1]];
+    if (!((p[dimension] < plane && q[dimension] > plane) ||
+          (p[dimension] > plane && q[dimension] < plane)))
+      continue;
+    const double f = (plane - p[dimension]) / (q[dimension] - p[dimension]);
+    double crossing[3];
+    for (int axis = 0; axis < 3; ++axis) crossing[axis] = p[axis] + f * (q[axis] - p[axis]);
+    crossing[dimension] = plane;
+    add(0, crossing);
+    add(1, crossing);
+  }
+  // Float boxes rounded outwards, within the primitive's box and on their side of the plane.
+  // A side the triangle does not reach inside the primitive's box collapses to a point there.
+  const float box_lower[3] = {primitive->lower_x, primitive->lower_y, primitive->lower_z};
+  const float box_upper[3] = {primitive->upper_x, primitive->upper_y, primitive->upper_z};
+  RTCBounds* out[2] = {left_bounds, right_bounds};
+  for (int side = 0; side < 2; ++side) {
+    float lo[3], hi[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      lo[axis] = std::max(round_down(lower[side][axis]), box_lower[axis]);
+      hi[axis] = std::min(round_up(upper[side][axis]), box_upper[axis]);
+    }
+    if (side == 0) hi[dimension] = std::min(hi[dimension], position);
+    if (side == 1) lo[dimension] = std::max(lo[dimension], position);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (lo[axis] <= hi[axis]) continue;
+      lo[axis] = hi[axis] = axis == static_cast<int>(dimension)
+                                ? std::clamp(position, box_lower[axis], box_upper[axis])
+                                : box_lower[axis];
+    }
+    *out[side] = RTCBounds{lo[0], lo[1], lo[2], 0, hi[0], hi[1], hi[2], 0};
+  }
 }
 
 RTCBuildQuality embree_quality(LineQueryBuildQuality quality) {
@@ -134,10 +205,11 @@ struct NodeTestSetup {
 };
 
 // What the node test returns for each surviving child: the t-range its box projects to on the
-// segment.
+// segment and the lower bound of its depth s (the near-to-far order).
 struct ChildRanges {
   float t_lower[LineQuery::kWidth];
   float t_upper[LineQuery::kWidth];
+  float depth_lower[LineQuery::kWidth];
 };
 
 // The node test: the eight child boxes at once (lanes.h: SSE2 halves or AVX, the same float
@@ -197,13 +269,15 @@ inline unsigned test_children(const LineQuery::Node& node, const NodeTestSetup& 
   lanes::store(out.t_lower,
                beta_lower_clamped / lanes::maximum(alpha_upper + beta_lower_clamped, tiny));
   lanes::store(out.t_upper, beta_upper / lanes::maximum(alpha_lower_clamped + beta_upper, tiny));
+  lanes::store(out.depth_lower, depth_lower);
   return mask;
 }
 
+// The AVX build also counts bits with POPCNT (every AVX CPU has it).
 bool cpu_has_avx() {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx");
+  return __builtin_cpu_supports("avx") && __builtin_cpu_supports("popcnt");
 #else
   return false;
 #endif
@@ -306,12 +380,12 @@ inline void set_up_node_test(const ShadowTriangle& shadow, const Vec3& scene_max
   }
 }
 
-// The walk: nodes tested eight children at a time, surviving children pushed nearest first,
-// exact crossings at the leaves. Inlined whole into traverse_sse and traverse_avx (below), so
-// that the node test and occluder_cut are compiled for each instruction set and the query's
-// constants stay in registers.
-// Returns false, with `out` untouched, when the shadow triangle is degenerate (the caller
-// answers those with a shadow ray).
+// One query: the shadow triangle and the node test's constants, then the walk (nodes tested
+// eight children at a time, surviving children pushed so that the nearest is popped first,
+// exact crossings at the leaves). Inlined whole into query_sse and query_avx (below), so that
+// the node test and occluder_cut are compiled for each instruction set. Returns false, with
+// `out` untouched, when the shadow triangle is degenerate (the caller answers those with a
+// shadow ray).
 template <class Mask>
 inline bool query(const Traversal& traversal, const Vec3& x, const Vec3& a, const Vec3& b,
                   IntervalList& out, LineQueryStats* stats) {
@@ -356,13 +430,27 @@ inline bool query(const Traversal& traversal, const Vec3& x, const Vec3& a, cons
     const LineQuery::Node& node = traversal.nodes[code];
     ++nodes_visited;
     unsigned mask = test_children<Mask>(node, setup, ranges);
-    // Push the surviving children, the lowest slot last so that it is popped first. (Whether
-    // their projection is already occluded is checked when they are popped. Sorting them by
-    // depth, nearest first, measured no fewer triangle tests and cuts on the bundled scenes,
-    // and cost instructions and mispredicted branches.)
-    while (mask != 0) {
-      const int slot = 31 - __builtin_clz(mask);
-      mask ^= 1u << slot;
+    if (mask == 0) continue;
+    // Push the surviving children far to near, so that the nearest is popped first (near
+    // occluders cut the most; on a dense closed mesh the near side's cuts then cull the far
+    // side's nodes). Each child's place is its rank by depth, counted with one vector compare
+    // (ties by slot): no data-dependent branch per child. (Whether their projection is already
+    // occluded is checked when they are popped.)
+    int order[LineQuery::kWidth];
+    const int kept = __builtin_popcount(mask);
+    if (kept == 1) {
+      order[0] = __builtin_ctz(mask);
+    } else {
+      const lanes::F8 depth = lanes::load(ranges.depth_lower);
+      for (unsigned rest = mask; rest != 0; rest &= rest - 1) {
+        const int slot = __builtin_ctz(rest);
+        const unsigned nearer = Mask::of(depth < ranges.depth_lower[slot]) |
+                                (Mask::of(depth == ranges.depth_lower[slot]) & ((1u << slot) - 1));
+        order[__builtin_popcount(nearer & mask)] = slot;
+      }
+    }
+    for (int i = kept - 1; i >= 0; --i) {
+      const int slot = order[i];
       const uint32_t child = node.child[slot];
       stack.push(child, ranges.t_lower[slot], ranges.t_upper[slot]);
       // Start loading it now: the walk is bound by memory on large scenes (small ones stay in
@@ -395,9 +483,10 @@ __attribute__((flatten)) bool query_sse(const Traversal& traversal, const Vec3& 
   return query<lanes::SseMask>(traversal, x, a, b, out, stats);
 }
 #if defined(__x86_64__) || defined(__i386__)
-__attribute__((target("avx"), flatten)) bool query_avx(const Traversal& traversal, const Vec3& x,
-                                                       const Vec3& a, const Vec3& b,
-                                                       IntervalList& out, LineQueryStats* stats) {
+__attribute__((target("avx,popcnt"), flatten)) bool query_avx(const Traversal& traversal,
+                                                              const Vec3& x, const Vec3& a,
+                                                              const Vec3& b, IntervalList& out,
+                                                              LineQueryStats* stats) {
   return query<lanes::AvxMask>(traversal, x, a, b, out, stats);
 }
 #else
@@ -490,16 +579,33 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   arguments.traversalCost = 1.0f;
   arguments.intersectionCost = 1.0f;
   arguments.bvh = bvh;
+  // The union of the triangles' boxes (a root for a single leaf), before Embree reorders them.
+  RTCBounds all_bounds{primitives[0].lower_x, primitives[0].lower_y, primitives[0].lower_z, 0,
+                       primitives[0].upper_x, primitives[0].upper_y, primitives[0].upper_z, 0};
+  for (const RTCBuildPrimitive& p : primitives) {
+    all_bounds.lower_x = std::min(all_bounds.lower_x, p.lower_x);
+    all_bounds.lower_y = std::min(all_bounds.lower_y, p.lower_y);
+    all_bounds.lower_z = std::min(all_bounds.lower_z, p.lower_z);
+    all_bounds.upper_x = std::max(all_bounds.upper_x, p.upper_x);
+    all_bounds.upper_y = std::max(all_bounds.upper_y, p.upper_y);
+    all_bounds.upper_z = std::max(all_bounds.upper_z, p.upper_z);
+  }
+  // Spatial splits (HIGH) add references to parts of triangles: room for twice as many.
+  const bool spatial_splits = options_.build_quality == LineQueryBuildQuality::High;
+  const size_t primitive_count = primitives.size();
+  if (spatial_splits) primitives.resize(2 * primitive_count);
   arguments.primitives = primitives.data();
-  arguments.primitiveCount = primitives.size();
+  arguments.primitiveCount = primitive_count;
   arguments.primitiveArrayCapacity = primitives.size();
   arguments.createNode = create_inner;
   arguments.setNodeChildren = set_children;
   arguments.setNodeBounds = set_bounds;
   arguments.createLeaf = create_leaf;
-  arguments.splitPrimitive = nullptr;  // no spatial splits
+  arguments.splitPrimitive = spatial_splits ? split_primitive : nullptr;
   arguments.buildProgress = nullptr;
   BuildStatus status;
+  status.occluders = &occluders;
+  status.build_scale = build_scale;
   arguments.userPtr = &status;
   auto* root = static_cast<BuildNode*>(rtcBuildBVH(&arguments));
   if (!root) {
@@ -563,17 +669,7 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   if (root->is_leaf) {
     // A single leaf: give it a root node, with the union of its triangles' boxes.
     uint32_t index = new_node();
-    RTCBounds bounds{primitives[0].lower_x, primitives[0].lower_y, primitives[0].lower_z, 0,
-                     primitives[0].upper_x, primitives[0].upper_y, primitives[0].upper_z, 0};
-    for (const RTCBuildPrimitive& p : primitives) {
-      bounds.lower_x = std::min(bounds.lower_x, p.lower_x);
-      bounds.lower_y = std::min(bounds.lower_y, p.lower_y);
-      bounds.lower_z = std::min(bounds.lower_z, p.lower_z);
-      bounds.upper_x = std::max(bounds.upper_x, p.upper_x);
-      bounds.upper_y = std::max(bounds.upper_y, p.upper_y);
-      bounds.upper_z = std::max(bounds.upper_z, p.upper_z);
-    }
-    set_slot(index, 0, bounds, flatten_leaf(reinterpret_cast<const BuildLeaf*>(root)));
+    set_slot(index, 0, all_bounds, flatten_leaf(reinterpret_cast<const BuildLeaf*>(root)));
   } else {
     try {
       flatten(flatten, root, 1);

@@ -14,7 +14,8 @@
 //   shadow triangle's plane, its side planes through x, the plane through the segment and
 //   the self-occlusion plane near x, with a conservative float error bound; each surviving
 //   child's box is projected from x onto the segment and skipped when that t-range is already
-//   occluded (checked when it is popped); the query stops as soon as nothing stays visible;
+//   occluded (checked when it is popped); children are visited nearest to x first (near
+//   occluders cut the most); the query stops as soon as nothing stays visible;
 // - exact double-precision crossings at the leaves (core/lines/shadow_triangle.h, inlined
 //   into both builds), watertight at shared edges, so the result equals
 //   visible_intervals_brute_force.
@@ -36,7 +37,9 @@ enum class LineQueryBuildQuality { Low, Medium, High };
 
 struct LineQueryOptions {
   ShadowTriangleTolerances tolerances;
-  // Embree's SAH builder quality. HIGH runs without spatial splits (no split callback).
+  // Embree's SAH builder quality. HIGH adds spatial splits (SBVH): a triangle may be referenced
+  // by several leaves, each through the box of its part there (tighter for long, slanted
+  // triangles; more memory).
   LineQueryBuildQuality build_quality = LineQueryBuildQuality::Medium;
   unsigned max_leaf_size = 4;  // triangles per leaf
   // Run the traversal's AVX build when the CPU has AVX. The SSE2 build computes the same values
