@@ -34,6 +34,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/lines/line_query.h"
@@ -367,25 +368,36 @@ class RatioReporter : public benchmark::ConsoleReporter {
   }
   void print_summary() const {
     std::printf("\nPer query, one thread, CPU time (median when repeated):\n");
-    std::printf("%-24s %14s %18s %8s %18s %8s\n", "scene", "shadow ray ns", "line medium ns",
-                "ratio", "line high ns", "ratio");
+    std::printf("%-28s %13s %14s %14s %7s %14s %7s\n", "scene", "shadow ray ns", "line medium ns",
+                "medium q/s", "ratio", "line high ns", "ratio");
+    auto find = [&](const std::string& key) {
+      auto found = nanoseconds_.find(key);
+      return found == nanoseconds_.end() ? -1.0 : found->second;
+    };
+    std::vector<std::pair<double, std::string>> bundled;  // medium ratio, scene
     for (const std::string& scene : scenes) {
-      auto find = [&](const std::string& key) {
-        auto found = nanoseconds_.find(key);
-        return found == nanoseconds_.end() ? -1.0 : found->second;
-      };
       double ray = find("shadow_ray/" + scene);
       double medium = find("line_query_medium/" + scene);
       double high = find("line_query_high/" + scene);
-      if (ray <= 0) continue;
+      if (ray <= 0 || medium <= 0) continue;
+      std::printf("%-28s %13.1f %14.1f %14.0f %7.2f", scene.c_str(), ray, medium, 1e9 / medium,
+                  medium / ray);
       if (high > 0) {
-        std::printf("%-24s %14.1f %18.1f %8.2f %18.1f %8.2f\n", scene.c_str(), ray, medium,
-                    medium / ray, high, high / ray);
+        std::printf(" %14.1f %7.2f\n", high, high / ray);
       } else {
-        std::printf("%-24s %14.1f %18.1f %8.2f %18s %8s\n", scene.c_str(), ray, medium,
-                    medium / ray, "-", "-");
+        std::printf(" %14s %7s\n", "-", "-");
       }
+      if (scene.rfind("scene:", 0) == 0) bundled.emplace_back(medium / ray, scene);
     }
+    if (bundled.empty()) return;
+    // The distribution over the bundled scenes (medium build).
+    std::sort(bundled.begin(), bundled.end());
+    const auto& median = bundled[bundled.size() / 2];
+    std::printf(
+        "\nLine query / shadow ray over %zu bundled scenes (medium build): min %.2f (%s), "
+        "median %.2f (%s), max %.2f (%s)\n",
+        bundled.size(), bundled.front().first, bundled.front().second.c_str(), median.first,
+        median.second.c_str(), bundled.back().first, bundled.back().second.c_str());
   }
 
  private:
