@@ -79,6 +79,9 @@ class Store {
   uint64_t add_job(const JobRecord& job);
   // Writes the mutable fields (state, error, times, blocks, compute seconds, final errors).
   void update_job(const JobRecord& job);
+  // Writes the job's specification and its mutable fields in one transaction (a batch run
+  // given its pass count, server/coordinator.h set_pass_count).
+  void update_job_spec(const JobRecord& job);
   std::vector<JobRecord> jobs();
 
   // Records a completed task durably. Concurrent callers are committed together in one
