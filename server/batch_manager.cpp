@@ -48,13 +48,15 @@ uint32_t passes_for_budget(double budget, double seconds_per_pass, uint32_t max_
   return uint32_t(std::clamp<double>(std::llround(passes), 1.0, double(max_spp)));
 }
 
-// Calibration and runs render the same passes per task, so that the per-task overhead in the
-// measured compute seconds (tile setup, the worker's RPC threads) weighs the same per pass; one
-// pass per task keeps the calibration's smallest block (every tile, one pass) short on large
-// images.
-constexpr uint32_t kPassesPerTask = 1;
-
 }  // namespace
+
+void BatchManager::Wakeup::notify() {
+  {
+    std::lock_guard lock(mutex);
+    pending = true;
+  }
+  condition.notify_all();
+}
 
 bool BatchManager::is_terminal(v1::BatchState state) {
   return state == v1::BATCH_STATE_DONE || state == v1::BATCH_STATE_FAILED ||
@@ -85,16 +87,18 @@ BatchManager::BatchManager(Coordinator& coordinator, SceneParser parser,
                    v1::BatchState_Name(batch->stored.status().state()));
     batches_[number] = std::move(batch);
   }
+  coordinator_.set_batch_listener([wakeup = wakeup_] { wakeup->notify(); });
   driver_ = std::thread([this] { drive_loop(); });
 }
 
 BatchManager::~BatchManager() {
+  coordinator_.set_batch_listener({});
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
     ++version_;
   }
-  wake_.notify_all();
+  wakeup_->notify();
   changed_.notify_all();
   if (driver_.joinable()) driver_.join();
 }
@@ -250,7 +254,7 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
     response.set_batch_id(b.stored.status().batch_id());
     response.set_scene_hash(scene.content_hash);
   }
-  wake_.notify_all();
+  wakeup_->notify();
   return response;
 }
 
@@ -320,22 +324,27 @@ void BatchManager::changed_locked() {
 }
 
 void BatchManager::drive_loop() {
-  std::unique_lock lock(mutex_);
-  while (!stopping_) {
-    bool active = false;
-    for (auto& [number, batch] : batches_) {
-      if (is_terminal(batch->stored.status().state())) continue;
-      active = true;
-      try {
-        advance(*batch);
-      } catch (const std::exception& error) {
-        spdlog::error("{}: {}", batch->stored.status().batch_id(), error.what());
-        fail(*batch, error.what());
+  while (true) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return;
+      bool active = false;
+      for (auto& [number, batch] : batches_) {
+        if (is_terminal(batch->stored.status().state())) continue;
+        active = true;
+        try {
+          advance(*batch);
+        } catch (const std::exception& error) {
+          spdlog::error("{}: {}", batch->stored.status().batch_id(), error.what());
+          fail(*batch, error.what());
+        }
       }
+      // Jobs progress without the batch record changing: watchers poll while anything runs.
+      if (active) changed_locked();
     }
-    // Jobs progress without the batch record changing: watchers poll while anything runs.
-    if (active) changed_locked();
-    wake_.wait_for(lock, options_.poll);
+    std::unique_lock lock(wakeup_->mutex);
+    wakeup_->condition.wait_for(lock, options_.poll, [&] { return wakeup_->pending; });
+    wakeup_->pending = false;
   }
 }
 
@@ -371,14 +380,37 @@ std::string BatchManager::reference_cache_key(const Batch& batch) const {
          std::to_string(reference.seed);
 }
 
-std::string BatchManager::submit_job(Batch& batch, v1::JobSpec spec, bool in_batch) {
+std::string BatchManager::submit_job(Batch& batch, v1::JobSpec spec, bool in_batch,
+                                     bool awaits_pass_count) {
   spec.set_scene_hash(batch.stored.status().scene_hash());
   if (spec.name().empty()) spec.set_name(batch.stored.status().batch_id());
   spec.set_owner(batch.stored.status().owner());
   v1::SubmitJobResponse response =
-      in_batch ? coordinator_.submit_in_batch(spec, batch.stored.status().batch_id())
-               : coordinator_.submit(spec);
+      in_batch
+          ? coordinator_.submit_in_batch(spec, batch.stored.status().batch_id(), awaits_pass_count)
+          : coordinator_.submit(spec);
   return response.job_id();
+}
+
+// Blocks of about passes / blocks_per_run passes, within [at_least, max_passes_per_task].
+uint32_t BatchManager::passes_per_task_for(uint32_t passes, uint32_t at_least) const {
+  uint32_t blocks = std::max<uint32_t>(options_.blocks_per_run, 1);
+  uint32_t per_block = (passes + blocks - 1) / blocks;
+  uint32_t most = std::max<uint32_t>(options_.max_passes_per_task, 1);
+  return std::clamp<uint32_t>(per_block, std::min(std::max<uint32_t>(at_least, 1), most), most);
+}
+
+v1::JobSpec BatchManager::run_spec(const Batch& batch, const v1::BatchMethodStatus& method,
+                                   uint32_t repeat, bool equal_time) const {
+  v1::JobSpec spec;
+  spec.set_method(method.method());
+  spec.set_sampler(method.sampler());
+  spec.set_seed(batch.spec.seed + repeat);
+  std::string name = batch.stored.status().batch_id();
+  name.append(" ").append(method.label()).append(" r").append(std::to_string(repeat));
+  spec.set_name(name + (equal_time ? " equal time" : ""));
+  attach_reference(batch, spec);
+  return spec;
 }
 
 void BatchManager::attach_reference(const Batch& batch, v1::JobSpec& spec) const {
@@ -414,6 +446,7 @@ bool BatchManager::advance_reference(Batch& batch) {
       spec.set_sampler(batch.spec.reference.sampler);
       spec.set_seed(batch.spec.reference.seed);
       spec.set_spp(batch.spec.reference.spp);
+      spec.set_passes_per_task(passes_per_task_for(batch.spec.reference.spp, 1));
       spec.set_name("reference for " + status.scene_name() + " (" + status.batch_id() + ")");
       reference.set_job_id(submit_job(batch, spec, false));
       reference_cache_[key] = reference.job_id();
@@ -442,102 +475,155 @@ bool BatchManager::advance_reference(Batch& batch) {
 }
 
 bool BatchManager::advance_calibration(Batch& batch) {
-  v1::BatchStatus& status = *batch.stored.mutable_status();
-  bool changed = false;
-  for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
-    if (!method.error().empty() || !method.calibration_job().empty()) continue;
-    v1::JobSpec spec;
-    spec.set_method(method.method());
-    spec.set_sampler(method.sampler());
-    spec.set_seed(batch.spec.seed + 0x9e3779b9ull);  // not the runs' samples
-    // A short seconds budget: as many pass blocks as fit in a small share of the method's
-    // budget (at least one), whatever the scene costs.
-    spec.set_compute_seconds(std::max(1e-3, method.budget_seconds() * options_.calibration_share));
-    spec.set_passes_per_task(kPassesPerTask);
-    spec.set_name(status.batch_id() + " calibration " + method.label());
-    method.set_calibration_job(submit_job(batch, spec, true));
-    changed = true;
-  }
-  std::vector<v1::JobStatus> jobs;
-  for (const v1::BatchMethodStatus& method : status.methods()) {
-    if (!method.error().empty()) continue;
-    jobs.push_back(coordinator_.status(method.calibration_job(), false));
-    if (!job_terminal(jobs.back().state())) return changed;
-  }
-  size_t next = 0;
-  for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
-    if (!method.error().empty()) continue;
-    const v1::JobStatus& job = jobs[next++];
-    if (job.state() != v1::JOB_STATE_DONE || job.passes_complete() == 0 ||
-        !(job.compute_seconds() > 0)) {
-      method.set_error("calibration " + job.job_id() + " ended " + v1::JobState_Name(job.state()) +
-                       (job.error().empty() ? std::string() : ": " + job.error()));
-      continue;
-    }
-    method.set_calibration_passes(job.passes_complete());
-    method.set_seconds_per_pass(job.compute_seconds() / double(job.passes_complete()));
-    spdlog::info("{}: {} costs {:.4f} compute seconds per pass", status.batch_id(), method.label(),
-                 method.seconds_per_pass());
-  }
-  status.set_state(v1::BATCH_STATE_RUNNING);
+  bool changed = submit_runs(batch);
+  changed = drive_equal_time_runs(batch) || changed;
+  // Calibrated: every equal-time job has its cost per pass, or has ended.
+  for (const v1::BatchMethodStatus& method : batch.stored.status().methods())
+    for (const v1::BatchRun& run : method.runs())
+      if (run.equal_time() && run.seconds_per_pass() == 0 &&
+          !job_terminal(coordinator_.status(run.job_id(), false).state()))
+        return changed;
+  batch.stored.mutable_status()->set_state(v1::BATCH_STATE_RUNNING);
   return true;
 }
 
 bool BatchManager::advance_runs(Batch& batch) {
-  v1::BatchStatus& status = *batch.stored.mutable_status();
-  bool submitted = std::any_of(status.methods().begin(), status.methods().end(),
-                               [](const v1::BatchMethodStatus& m) { return m.runs_size() > 0; });
-  bool changed = false;
-  if (!submitted) {
-    // Repeat by repeat, method by method: with round-robin serving every method's jobs advance
-    // together.
-    for (uint32_t repeat = 0; repeat < batch.spec.repeats; ++repeat) {
-      for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
-        if (!method.error().empty()) continue;
-        auto add_run = [&](uint32_t spp, bool equal_time) {
-          v1::JobSpec spec;
-          spec.set_method(method.method());
-          spec.set_sampler(method.sampler());
-          spec.set_seed(batch.spec.seed + repeat);
-          spec.set_spp(spp);
-          spec.set_passes_per_task(kPassesPerTask);
-          std::string name = status.batch_id();
-          name.append(" ").append(method.label()).append(" r").append(std::to_string(repeat));
-          if (equal_time)
-            name.append(" equal time");
-          else
-            name.append(" ").append(std::to_string(spp)).append(" spp");
-          spec.set_name(name);
-          attach_reference(batch, spec);
-          v1::BatchRun* run = method.add_runs();
-          run->set_repeat(repeat);
-          run->set_seed(spec.seed());
-          run->set_equal_time(equal_time);
-          run->set_spp_planned(spp);
-          run->set_job_id(submit_job(batch, spec, true));
-        };
-        if (method.has_budget_seconds())
-          add_run(passes_for_budget(method.budget_seconds(), method.seconds_per_pass(),
-                                    options_.max_spp),
-                  true);
-        for (uint32_t spp : batch.spec.budget_spp) add_run(spp, false);
-      }
-    }
-    store_.save(batch.stored);
-    changed = true;
-  }
-  for (const v1::BatchMethodStatus& method : status.methods())
+  bool changed = submit_runs(batch);
+  changed = drive_equal_time_runs(batch) || changed;
+  for (const v1::BatchMethodStatus& method : batch.stored.status().methods())
     for (const v1::BatchRun& run : method.runs())
       if (!job_terminal(coordinator_.status(run.job_id(), false).state())) return changed;
   finish(batch, v1::BATCH_STATE_DONE);
   return true;
 }
 
+// Every run at once, repeat by repeat and method by method, so that with round-robin serving
+// every method's jobs advance together; false when they were submitted before.
+bool BatchManager::submit_runs(Batch& batch) {
+  v1::BatchStatus& status = *batch.stored.mutable_status();
+  if (std::any_of(status.methods().begin(), status.methods().end(),
+                  [](const v1::BatchMethodStatus& m) { return m.runs_size() > 0; }))
+    return false;
+  for (uint32_t repeat = 0; repeat < batch.spec.repeats; ++repeat) {
+    for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
+      if (!method.error().empty()) continue;
+      auto add_run = [&](const v1::JobSpec& spec, bool equal_time) {
+        std::string job_id = submit_job(batch, spec, true, equal_time);
+        v1::BatchRun* run = method.add_runs();
+        run->set_repeat(repeat);
+        run->set_seed(spec.seed());
+        run->set_equal_time(equal_time);
+        run->set_spp_planned(equal_time ? 0 : spec.spp());
+        run->set_job_id(job_id);
+        if (equal_time && repeat == 0) method.set_calibration_job(job_id);
+      };
+      if (method.has_budget_seconds()) {
+        // A seconds budget of a share of the method's budget, then it waits for its pass count.
+        v1::JobSpec spec = run_spec(batch, method, repeat, true);
+        spec.set_compute_seconds(
+            std::max(1e-3, method.budget_seconds() * options_.calibration_share));
+        spec.set_passes_per_task(std::max<uint32_t>(options_.calibration_passes_per_task, 1));
+        add_run(spec, true);
+      }
+      for (uint32_t spp : batch.spec.budget_spp) {
+        v1::JobSpec spec = run_spec(batch, method, repeat, false);
+        spec.set_name(spec.name() + " " + std::to_string(spp) + " spp");
+        spec.set_spp(spp);
+        spec.set_passes_per_task(passes_per_task_for(spp, 1));
+        add_run(spec, false);
+      }
+    }
+  }
+  store_.save(batch.stored);
+  return true;
+}
+
+bool BatchManager::drive_equal_time_runs(Batch& batch) {
+  bool changed = false;
+  for (v1::BatchMethodStatus& method : *batch.stored.mutable_status()->mutable_methods())
+    for (v1::BatchRun& run : *method.mutable_runs())
+      if (run.equal_time() && coordinator_.awaits_pass_count(run.job_id()))
+        changed = next_pass_count(batch, method, run) || changed;
+  return changed;
+}
+
+// An equal-time job waits: after its calibration it is given most of the pass count its cost
+// asks for, then its final count from the cost over every pass so far. Each count is stored
+// before the job is given it; after a restart the job is given again what it was to get.
+bool BatchManager::next_pass_count(Batch& batch, v1::BatchMethodStatus& method, v1::BatchRun& run) {
+  const v1::BatchStatus& status = batch.stored.status();
+  v1::JobStatus job = coordinator_.status(run.job_id(), false);
+  const uint32_t rendered = job.passes_complete();
+  const double budget = method.budget_seconds();
+  bool changed = false;
+  uint32_t spp = 0;
+  bool final = true;
+  if (rendered == 0 || !(job.compute_seconds() > 0)) {
+    spdlog::warn("{}: {} measured no compute time; it ends at {} passes", status.batch_id(),
+                 run.job_id(), rendered);
+    spp = std::max(rendered, 1u);
+    run.set_spp_planned(spp);
+    store_.save(batch.stored);
+    changed = true;
+  } else if (run.seconds_per_pass() == 0) {
+    run.set_calibration_passes(rendered);
+    run.set_seconds_per_pass(job.compute_seconds() / double(rendered));
+    const uint32_t wanted = passes_for_budget(budget, run.seconds_per_pass(), options_.max_spp);
+    run.set_first_pass_count(
+        std::max(rendered, uint32_t(std::llround(options_.first_count_share * double(wanted)))));
+    if (method.calibration_job() == run.job_id()) {
+      method.set_seconds_per_pass(run.seconds_per_pass());
+      method.set_calibration_passes(rendered);
+    }
+    spdlog::info(
+        "{}: {} r{} costs {:.4f} compute seconds per pass (over {} passes): {} spp, "
+        "{} first",
+        status.batch_id(), method.label(), run.repeat(), run.seconds_per_pass(), rendered, wanted,
+        run.first_pass_count());
+    store_.save(batch.stored);
+    changed = true;
+    spp = run.first_pass_count();
+    final = false;
+  } else if (job.spp_budget() == 0) {
+    spp = run.first_pass_count();  // restarted before the job took its first count
+    final = false;
+  } else if (run.spp_planned() == 0) {
+    const double cost = job.compute_seconds() / double(rendered);
+    run.set_spp_planned(std::max(rendered, passes_for_budget(budget, cost, options_.max_spp)));
+    spdlog::info("{}: {} r{} costs {:.4f} compute seconds per pass (over {} passes): {} spp",
+                 status.batch_id(), method.label(), run.repeat(), cost, rendered,
+                 run.spp_planned());
+    store_.save(batch.stored);
+    changed = true;
+    spp = run.spp_planned();
+  } else {
+    spp = run.spp_planned();  // restarted before the job took its final count
+  }
+  // The first count in blocks like a run's (points of the MRSE curve), the last few passes in
+  // one block (fewer, larger results).
+  const uint32_t rest = spp - std::min(spp, rendered);
+  const uint32_t passes_per_task =
+      final ? std::clamp<uint32_t>(rest, 1, std::max<uint32_t>(options_.max_passes_per_task, 1))
+            : passes_per_task_for(rest, options_.calibration_passes_per_task);
+  try {
+    coordinator_.set_pass_count(run.job_id(), spp, passes_per_task, final);
+  } catch (const FarmError& error) {
+    // A full queue: again later. A job cancelled since it was asked: it has ended.
+    if (error.code() != FarmErrorCode::ResourceExhausted &&
+        error.code() != FarmErrorCode::FailedPrecondition)
+      throw;
+    spdlog::warn("{}: no pass count given ({}); trying again", run.job_id(), error.what());
+  }
+  return changed;
+}
+
 std::vector<std::string> BatchManager::job_ids(const Batch& batch) const {
   std::vector<std::string> ids;
   for (const v1::BatchMethodStatus& method : batch.stored.status().methods()) {
-    if (!method.calibration_job().empty()) ids.push_back(method.calibration_job());
     for (const v1::BatchRun& run : method.runs()) ids.push_back(run.job_id());
+    if (!method.calibration_job().empty() &&
+        std::find(ids.begin(), ids.end(), method.calibration_job()) == ids.end())
+      ids.push_back(method.calibration_job());
   }
   return ids;
 }
@@ -582,7 +668,13 @@ v1::BatchStatus BatchManager::status_locked(const Batch& batch, bool with_curves
     }
   }
   for (v1::BatchMethodStatus& method : *status.mutable_methods()) {
-    if (!method.calibration_job().empty()) {
+    // A calibration job of its own (batches stored before calibrations were runs).
+    const bool separate =
+        !method.calibration_job().empty() &&
+        std::none_of(method.runs().begin(), method.runs().end(), [&](const v1::BatchRun& run) {
+          return run.job_id() == method.calibration_job();
+        });
+    if (separate) {
       try {
         count(coordinator_.status(method.calibration_job(), false));
       } catch (const std::exception&) {

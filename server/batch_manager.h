@@ -7,13 +7,22 @@
 //   1. reference: "auto" renders the spec's reference settings as a job, cached by scene hash
 //      and settings (persisted, so a restarted coordinator reuses it too); "job:<id>" waits for
 //      that job; an uploaded EXR is ready at once.
-//   2. calibration (when the spec has a seconds budget): one short job per method (a seconds
-//      budget of calibration_share of the method's budget, 1 pass per task like the runs),
-//      all interleaved on the same workers; each method's measured compute seconds per pass
-//      gives its pass count for the budget: round(budget / cost).
-//   3. runs: per method and repeat an equal-time job (that pass count) and one job per spp
-//      level, every job against the reference (so the coordinator records the MRSE curve at
-//      every pass boundary). The batch's jobs are served round-robin (server/scheduler.h).
+//   2. calibration (when the spec has a seconds budget): every run is submitted, per method and
+//      repeat an equal-time job and one job per spp level, all served round-robin on the same
+//      workers (server/scheduler.h), every job against the reference (so the coordinator
+//      records the MRSE curve at every pass boundary). An equal-time job calibrates itself: it
+//      starts with a seconds budget of calibration_share of the method's budget, in small pass
+//      blocks, and then waits (Coordinator::awaits_pass_count). Its compute seconds per pass
+//      give the pass count that fills the budget, round(budget / cost); the job is first given
+//      first_count_share of it (Coordinator::set_pass_count) and waits again, then gets its
+//      final count from the cost over all its passes so far, so a calibration window that the
+//      machine's load made slower or faster than the rest of the run does not miss the budget.
+//      No pass is thrown away, the run's compute seconds include its calibration, and its image
+//      is the one a job of its final spp and seed renders in one go.
+//   3. runs: once every equal-time job is calibrated, until every job has ended.
+// Spec-level-only batches skip 2. The manager moves a batch on when the coordinator reports
+// that one of its jobs ended or waits for a pass count (Coordinator::set_batch_listener), and
+// at least every `poll`.
 // A method the estimator refuses for the scene is recorded with its error and never runs.
 // Batches are persisted (server/batch_store.h) and resumed after a restart.
 
@@ -36,8 +45,20 @@ namespace penumbra::farm {
 
 struct BatchManagerOptions {
   std::string data_dir;  // the coordinator's; batches go in <data_dir>/batches
-  // Each method's calibration job renders for this share of its budget (compute seconds).
-  double calibration_share = 0.08;
+  // Each equal-time job's calibration renders for this share of its budget (compute seconds), in
+  // blocks of calibration_passes_per_task passes (small: a block of a costly method on a large
+  // image stays well within the share of a short budget).
+  double calibration_share = 0.05;
+  uint32_t calibration_passes_per_task = 4;
+  // The share of the pass count the calibration asks for that an equal-time job is given first
+  // (room for the cost per pass to grow by 1 / share - 1 before the budget is overrun).
+  double first_count_share = 0.85;
+  // Runs of a known pass count (and the rest of a calibrated run) go in blocks of about
+  // passes / blocks_per_run passes (each block is a point of the MRSE curve), at least
+  // calibration_passes_per_task (spp levels: 1) and at most max_passes_per_task: larger blocks
+  // mean fewer results to send and store per pass.
+  uint32_t blocks_per_run = 4;
+  uint32_t max_passes_per_task = 64;
   std::chrono::milliseconds poll{100};
   BatchLimits limits;
   uint32_t max_spp = 1u << 20;  // of any job (the coordinator's limit)
@@ -84,7 +105,14 @@ class BatchManager {
   bool advance_reference(Batch& batch);
   bool advance_calibration(Batch& batch);
   bool advance_runs(Batch& batch);
-  std::string submit_job(Batch& batch, v1::JobSpec spec, bool in_batch);
+  bool submit_runs(Batch& batch);
+  bool drive_equal_time_runs(Batch& batch);
+  bool next_pass_count(Batch& batch, v1::BatchMethodStatus& method, v1::BatchRun& run);
+  v1::JobSpec run_spec(const Batch& batch, const v1::BatchMethodStatus& method, uint32_t repeat,
+                       bool equal_time) const;
+  uint32_t passes_per_task_for(uint32_t passes, uint32_t at_least) const;
+  std::string submit_job(Batch& batch, v1::JobSpec spec, bool in_batch,
+                         bool awaits_pass_count = false);
   void attach_reference(const Batch& batch, v1::JobSpec& spec) const;
   std::string reference_cache_key(const Batch& batch) const;
   void fail(Batch& batch, const std::string& error);
@@ -104,7 +132,15 @@ class BatchManager {
   uint64_t version_ = 0;
   std::condition_variable changed_;
   bool stopping_ = false;
-  std::condition_variable wake_;
+  // Wakes the driver: a submission, the coordinator's batch listener, the destructor. Shared
+  // with the listener, which may run after this manager is gone.
+  struct Wakeup {
+    std::mutex mutex;
+    std::condition_variable condition;
+    bool pending = false;
+    void notify();
+  };
+  std::shared_ptr<Wakeup> wakeup_ = std::make_shared<Wakeup>();
   std::thread driver_;
 };
 

@@ -34,6 +34,31 @@ FarmError invalid(const std::string& message) {
   return FarmError(FarmErrorCode::InvalidArgument, message);
 }
 
+// The pass schedule: blocks of passes_per_task passes from pass 0, then the phases (each pass
+// count a calibrated batch run was given starts one where its earlier blocks end).
+uint64_t first_pass_of_block(const v1::StoredJob& stored, uint64_t block) {
+  uint64_t first_block = 0, first_pass = 0, passes = stored.passes_per_task();
+  for (const v1::PassPhase& phase : stored.phases()) {
+    if (phase.first_block() > block) break;
+    first_block = phase.first_block();
+    first_pass = phase.first_pass();
+    passes = phase.passes_per_task();
+  }
+  return first_pass + (block - first_block) * passes;
+}
+
+// The number of blocks that cover passes [0, spp).
+uint32_t blocks_for_passes(const v1::StoredJob& stored, uint32_t spp) {
+  uint64_t first_block = 0, first_pass = 0, passes = stored.passes_per_task();
+  for (const v1::PassPhase& phase : stored.phases()) {
+    if (phase.first_pass() >= spp) break;
+    first_block = phase.first_block();
+    first_pass = phase.first_pass();
+    passes = phase.passes_per_task();
+  }
+  return uint32_t(first_block + (spp - first_pass + passes - 1) / passes);
+}
+
 }  // namespace
 
 struct Coordinator::Job {
@@ -51,6 +76,10 @@ struct Coordinator::Job {
   };
   std::map<uint64_t, PendingResult> pending;  // completed tasks of unsealed blocks
   double sealed_compute_seconds = 0;          // of the tasks merged into `sealed`
+  // The store's sums hold blocks [0, durable_blocks) (the last checkpoint) and their compute
+  // seconds; it keeps the task results of the sealed blocks after them.
+  uint32_t durable_blocks = 0;
+  double durable_compute_seconds = 0;
   std::map<uint64_t, int> failures;
   uint64_t tasks_completed_ever = 0;  // for the average task cost (seconds budgets)
   double task_seconds_ever = 0;
@@ -125,7 +154,11 @@ void Coordinator::resume(const JobRecord& record) {
     j.mrse = j.curve.back().mrse;
   }
   if (is_terminal(record.state)) return;
-  j.sealed_compute_seconds = record.compute_seconds;  // the store keeps the sealed blocks' share
+  // The store's sums and compute seconds are the checkpointed blocks'; the task results hold
+  // the rest, sealed again below.
+  j.sealed_compute_seconds = record.compute_seconds;
+  j.durable_blocks = record.blocks_sealed;
+  j.durable_compute_seconds = record.compute_seconds;
 
   try {
     auto package = store_.scene(j.spec().scene_hash());
@@ -154,9 +187,8 @@ void Coordinator::resume(const JobRecord& record) {
     end_job(j, v1::JOB_STATE_FAILED, std::string("cannot resume after restart: ") + error.what());
     return;
   }
-  const uint32_t passes_per_task = j.stored.passes_per_task();
-  j.total_blocks = j.seconds_budget() ? options_.max_spp / passes_per_task
-                                      : (j.spec().spp() + passes_per_task - 1) / passes_per_task;
+  j.total_blocks = j.seconds_budget() ? options_.max_spp / j.stored.passes_per_task()
+                                      : blocks_for_passes(j.stored, j.spec().spp());
   // An spp job opens every block at submission; a crash may have come before that was written.
   if (!j.seconds_budget()) j.record.blocks_opened = j.total_blocks;
   j.record.blocks_opened = std::max<uint32_t>(j.record.blocks_opened, 1);
@@ -189,17 +221,20 @@ v1::SubmitJobResponse Coordinator::submit(const v1::JobSpec& request) {
 }
 
 v1::SubmitJobResponse Coordinator::submit_in_batch(const v1::JobSpec& request,
-                                                   const std::string& batch_id) {
+                                                   const std::string& batch_id,
+                                                   bool awaits_pass_count) {
   v1::JobSpec spec = request;
   spec.set_batch_id(batch_id);
-  return submit_spec(std::move(spec));
+  if (awaits_pass_count && spec.budget_case() != v1::JobSpec::kComputeSeconds)
+    throw invalid("spec.budget: a job that awaits its pass count starts with compute_seconds");
+  return submit_spec(std::move(spec), awaits_pass_count);
 }
 
 void Coordinator::store_scene(const std::string& scene_hash, const v1::ScenePackage& package) {
   store_.put_scene(scene_hash, package.SerializeAsString());
 }
 
-v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec) {
+v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pass_count) {
   // Validation and scene parsing happen outside the lock: they can take a while.
   if (spec.method().empty()) throw invalid("spec.method: empty; give a method such as \"sa\"");
   try {
@@ -316,11 +351,11 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec) {
     job->stored.set_height(uint32_t(scene->camera.height));
     job->stored.set_tile_size(tile_size);
     job->stored.set_passes_per_task(passes_per_task);
+    job->stored.set_awaits_pass_count(awaits_pass_count);
     job->tiles = std::move(tiles);
     job->tile_count = job->tiles.size();
-    job->total_blocks = job->seconds_budget()
-                            ? options_.max_spp / passes_per_task
-                            : (spec.spp() + passes_per_task - 1) / passes_per_task;
+    job->total_blocks = job->seconds_budget() ? options_.max_spp / passes_per_task
+                                              : blocks_for_passes(job->stored, spec.spp());
     uint64_t new_tasks =
         job->tile_count * (job->seconds_budget() ? 1 : uint64_t(job->total_blocks));
     if (scheduler_.queued_total() + new_tasks > options_.max_queued_tasks)
@@ -407,24 +442,23 @@ void Coordinator::seal_ready_blocks(Job& job) {
     if (uint64_t(std::distance(begin_it, end_it)) != job.tile_count) break;
     if (!std::all_of(begin_it, end_it, [](const auto& entry) { return entry.second.durable; }))
       break;
-    // Memory changes only once the store has the block: on a failed write (a full disk) the
-    // sealed tiles, curve and counts are put back and the block is sealed again later.
+    // Memory changes only once the store has what it must keep: on a failed write (a full disk)
+    // the sealed tiles, curve and counts are put back and the block is sealed again later.
     std::vector<TileAccumulator> sealed_before = job.sealed;
     const double sealed_seconds_before = job.sealed_compute_seconds;
     const bool has_mrse_before = job.has_mrse;
     const double mrse_before = job.mrse;
-    std::map<uint32_t, std::string> tiles;
     for (auto it = begin_it; it != end_it; ++it) {
-      uint32_t tile = uint32_t(it->first - first);
-      job.sealed[tile].merge(it->second.tile);
+      job.sealed[it->first - first].merge(it->second.tile);
       job.sealed_compute_seconds += it->second.compute_seconds;
-      tiles[tile] = job.sealed[tile].serialize();
     }
     ++job.record.blocks_sealed;
     uint32_t passes = task_passes(job, end - 1).second;
+    // After a restart, a block sealed before it has its curve point in the store already.
+    const bool recorded = !job.curve.empty() && job.curve.back().passes >= passes;
     std::optional<CurvePoint> point;
     load_reference(job);
-    if (job.reference) {
+    if (job.reference && !recorded) {
       Film film = assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
       try {
         CurvePoint p;
@@ -440,10 +474,29 @@ void Coordinator::seal_ready_blocks(Job& job) {
         spdlog::warn("{}: no MRSE: {}", job_name(job.record.id), error.what());
       }
     }
-    JobRecord durable = job.record;
-    durable.compute_seconds = job.sealed_compute_seconds;
+    // A checkpoint writes the merged sums and drops the task results they hold, once
+    // checkpoint_blocks sealed blocks have piled up, unless the job ends sooner (its end drops
+    // them all).
+    const uint32_t piled_up = job.record.blocks_sealed - job.durable_blocks;
+    const bool ends_soon = !job.seconds_budget() &&
+                           job.total_blocks - job.record.blocks_sealed < options_.checkpoint_blocks;
+    const bool checkpoint = piled_up >= std::max<uint32_t>(options_.checkpoint_blocks, 1) &&
+                            !(ends_soon && piled_up > 1);
     try {
-      store_.seal_block(durable, tiles, first, end, point);
+      if (checkpoint) {
+        std::map<uint32_t, std::string> tiles;
+        for (size_t tile = 0; tile < job.sealed.size(); ++tile)
+          tiles[uint32_t(tile)] = job.sealed[tile].serialize();
+        JobRecord durable = job.record;
+        durable.compute_seconds = job.sealed_compute_seconds;
+        store_.seal_block(durable, tiles, uint64_t(job.durable_blocks) * job.tile_count, end,
+                          point);
+        job.durable_blocks = job.record.blocks_sealed;
+        job.durable_compute_seconds = job.sealed_compute_seconds;
+      } else {
+        // The curve point and the job's fields (its state, its start) without the sums.
+        store_.seal_block(durable_record(job), {}, end, end, point);
+      }
     } catch (const std::exception& error) {
       spdlog::error("{}: cannot store sealed passes (will retry): {}", job_name(job.record.id),
                     error.what());
@@ -457,13 +510,105 @@ void Coordinator::seal_ready_blocks(Job& job) {
       return;
     }
     job.pending.erase(job.pending.lower_bound(first), job.pending.lower_bound(end));
-    spdlog::debug("{}: {} passes sealed", job_name(job.record.id), passes);
+    spdlog::debug("{}: {} passes sealed{}", job_name(job.record.id), passes,
+                  checkpoint ? " (checkpoint)" : "");
   }
   maybe_open_block(job);
+  if (waits_for_pass_count(job)) {
+    spdlog::info("{}: {} passes, {:.3f} compute seconds; waits for its pass count",
+                 job_name(job.record.id),
+                 task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second,
+                 job.record.compute_seconds);
+    return;
+  }
   if (!is_terminal(job.record.state) && job.record.blocks_sealed == job.record.blocks_opened &&
       scheduler_.queued(job.record.id) == 0 &&
       (job.seconds_budget() || job.record.blocks_sealed == job.total_blocks))
     finish(job);
+}
+
+// A job that awaits its pass count waits once every block it opened is sealed and its budget
+// is rendered: no more blocks fit in its seconds budget (maybe_open_block opened none), or every
+// block of the pass count it was given is sealed.
+bool Coordinator::waits_for_pass_count(const Job& job) const {
+  return job.stored.awaits_pass_count() && !is_terminal(job.record.state) &&
+         job.record.blocks_sealed > 0 && job.record.blocks_sealed == job.record.blocks_opened &&
+         scheduler_.queued(job.record.id) == 0 &&
+         (job.seconds_budget() || job.record.blocks_sealed == job.total_blocks);
+}
+
+JobRecord Coordinator::durable_record(const Job& job) const {
+  JobRecord durable = job.record;
+  durable.blocks_sealed = job.durable_blocks;
+  durable.compute_seconds = job.durable_compute_seconds;
+  return durable;
+}
+
+bool Coordinator::awaits_pass_count(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  return waits_for_pass_count(job_locked(job_id));
+}
+
+void Coordinator::set_pass_count(const std::string& job_id, uint32_t spp, uint32_t passes_per_task,
+                                 bool final) {
+  Notifications notifications;
+  {
+    std::lock_guard lock(mutex_);
+    Job& job = job_locked(job_id);
+    if (!job.stored.awaits_pass_count()) {
+      if (job.stored.phases_size() > 0) return;  // its final count was given before
+      throw FarmError(FarmErrorCode::FailedPrecondition,
+                      job_id + " does not await a pass count (not a calibrated batch run)");
+    }
+    if (is_terminal(job.record.state))
+      throw FarmError(
+          FarmErrorCode::FailedPrecondition,
+          job_id + " has ended (" + v1::JobState_Name(v1::JobState(job.record.state)) + ")");
+    if (!waits_for_pass_count(job))
+      throw FarmError(FarmErrorCode::FailedPrecondition,
+                      job_id + " is still rendering the passes it has");
+    if (spp == 0 || spp > options_.max_spp)
+      throw invalid("spp: " + std::to_string(spp) + " is outside [1, " +
+                    std::to_string(options_.max_spp) + "]");
+    if (passes_per_task == 0 || passes_per_task > 4096)
+      throw invalid("passes_per_task: " + std::to_string(passes_per_task) +
+                    " is outside [1, 4096]");
+    // The job goes on from the end of its last block, in a phase of blocks of its own.
+    const uint32_t rendered =
+        task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second;
+    v1::StoredJob stored = job.stored;
+    stored.mutable_spec()->set_spp(std::max(spp, rendered));
+    stored.set_awaits_pass_count(!final);
+    v1::PassPhase* phase = stored.add_phases();
+    phase->set_first_block(job.record.blocks_sealed);
+    phase->set_first_pass(rendered);
+    phase->set_passes_per_task(passes_per_task);
+    const uint32_t total_blocks = blocks_for_passes(stored, stored.spec().spp());
+    const uint64_t new_tasks = uint64_t(total_blocks - job.record.blocks_opened) * job.tile_count;
+    if (scheduler_.queued_total() + new_tasks > options_.max_queued_tasks)
+      throw FarmError(FarmErrorCode::ResourceExhausted,
+                      "the coordinator's queue is full: " + std::to_string(new_tasks) +
+                          " more tasks would exceed " + std::to_string(options_.max_queued_tasks));
+    JobRecord durable = durable_record(job);
+    durable.spec = stored.SerializeAsString();
+    durable.blocks_opened = total_blocks;
+    store_.update_job_spec(durable);
+    job.stored = std::move(stored);
+    job.record.spec = durable.spec;
+    job.total_blocks = total_blocks;
+    while (job.record.blocks_opened < job.total_blocks) open_block(job);
+    spdlog::info("{}: pass count {}{} ({} rendered, the rest in blocks of {})",
+                 job_name(job.record.id), job.spec().spp(), final ? "" : " for now", rendered,
+                 passes_per_task);
+    seal_ready_blocks(job);  // nothing more to render: finishes or waits again
+    collect_notifications(job.record.id, notifications);
+  }
+  run(notifications);
+}
+
+void Coordinator::set_batch_listener(std::function<void()> listener) {
+  std::lock_guard lock(mutex_);
+  batch_listener_ = std::move(listener);
 }
 
 void Coordinator::finish(Job& job) {
@@ -560,9 +705,9 @@ TileRect Coordinator::task_tile(const Job& job, uint64_t task_index) const {
 }
 
 std::pair<uint32_t, uint32_t> Coordinator::task_passes(const Job& job, uint64_t task_index) const {
-  uint32_t block = uint32_t(task_index / job.tile_count);
-  uint32_t begin = block * job.stored.passes_per_task();
-  uint32_t end = begin + job.stored.passes_per_task();
+  uint64_t block = task_index / job.tile_count;
+  uint32_t begin = uint32_t(first_pass_of_block(job.stored, block));
+  uint32_t end = uint32_t(first_pass_of_block(job.stored, block + 1));
   if (!job.seconds_budget()) end = std::min(end, job.spec().spp());
   return {begin, end};
 }
@@ -585,9 +730,8 @@ v1::JobStatus Coordinator::status_locked(const Job& job, bool with_curve) const 
   status.set_height(job.stored.height());
   status.set_spp_budget(job.seconds_budget() ? 0 : job.spec().spp());
   status.set_seconds_budget(job.seconds_budget() ? job.spec().compute_seconds() : 0);
-  uint32_t ppt = job.stored.passes_per_task();
   auto passes_of_blocks = [&](uint32_t blocks) {
-    uint32_t passes = blocks * ppt;
+    uint32_t passes = uint32_t(first_pass_of_block(job.stored, blocks));
     return job.seconds_budget() ? passes : std::min(passes, job.spec().spp());
   };
   status.set_passes_complete(passes_of_blocks(record.blocks_sealed));
@@ -696,6 +840,11 @@ void Coordinator::unsubscribe(uint64_t subscription) {
 void Coordinator::collect_notifications(uint64_t job_id, Notifications& out) const {
   for (const auto& [id, subscription] : subscriptions_)
     if (subscription.first == job_id) out.push_back(subscription.second);
+  if (!batch_listener_) return;
+  auto it = jobs_.find(job_id);
+  if (it == jobs_.end() || it->second->spec().batch_id().empty()) return;
+  if (is_terminal(it->second->record.state) || waits_for_pass_count(*it->second))
+    out.push_back(batch_listener_);
 }
 
 void Coordinator::run(const Notifications& notifications) {

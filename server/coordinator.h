@@ -8,9 +8,17 @@
 // 8 passes). An spp budget opens every block at submission; a seconds budget opens blocks one at
 // a time while the summed compute seconds stay under the budget, so the job stops at a pass
 // boundary with the same pass count in every tile. A block is sealed when every tile has
-// completed it: its results are merged into the per-tile sums (exactly, core/render/tile.h), the
-// MRSE against the reference is recorded, and the block's task results are dropped from the
-// store. The job is done when its last block is sealed: the EXR is assembled and stored.
+// completed it (and every result is durable): its results are merged into the per-tile sums
+// (exactly, core/render/tile.h) and the MRSE against the reference is recorded. The store keeps
+// the task results of sealed blocks until a checkpoint (every checkpoint_blocks blocks) writes
+// the merged sums and drops them (a restart merges them again), so a block's pixels are written
+// about once, not twice. The job is done when its last block is sealed: the EXR is stored.
+//
+// A batch's equal-time run (submit_in_batch with awaits_pass_count) starts as a seconds budget:
+// it renders blocks until that budget is spent (its calibration), then waits for the batch
+// manager to give it a pass count (set_pass_count) and renders on to it as an spp job, its later
+// blocks possibly larger; it waits again at each count until one is final. The image is the same
+// as a job of the final spp rendered in one go.
 
 #include <chrono>
 #include <condition_variable>
@@ -47,6 +55,9 @@ struct CoordinatorOptions {
   double max_seconds_budget = 1e7;
   int max_task_failures = 3;
   uint32_t max_tasks_per_lease = 256;
+  // Sealed blocks whose task results the store keeps before a checkpoint writes the merged
+  // sums (an spp job that will finish within this many more blocks skips it).
+  uint32_t checkpoint_blocks = 4;
   std::string build_flavour;  // empty: penumbra::kBuildFlavour
 };
 
@@ -77,7 +88,23 @@ class Coordinator {
   // Jobs (clients). A client's spec.batch_id is ignored.
   v1::SubmitJobResponse submit(const v1::JobSpec& spec);
   // A job of a batch (server/batch_manager.h): served round-robin with the batch's other jobs.
-  v1::SubmitJobResponse submit_in_batch(const v1::JobSpec& spec, const std::string& batch_id);
+  // `awaits_pass_count` (a seconds budget): once that budget is spent the job waits, RUNNING
+  // with nothing queued, for set_pass_count.
+  v1::SubmitJobResponse submit_in_batch(const v1::JobSpec& spec, const std::string& batch_id,
+                                        bool awaits_pass_count = false);
+  // True when the job has spent the seconds budget it was submitted with and waits for its pass
+  // count; its status then has the calibration's passes and compute seconds.
+  bool awaits_pass_count(const std::string& job_id);
+  // Gives a waiting job a pass count: it becomes an spp job of max(spp, passes rendered) passes,
+  // the rest in blocks of `passes_per_task`, persisted before this returns; unless `final` it
+  // waits again once they are rendered. Again on a job that was given its final count: nothing
+  // happens. FailedPrecondition for a job that does not wait (or not yet), InvalidArgument for
+  // counts out of range.
+  void set_pass_count(const std::string& job_id, uint32_t spp, uint32_t passes_per_task,
+                      bool final = true);
+  // Called (from any thread, never under the coordinator's lock) when a batch's job ends or
+  // starts waiting for its pass count. One listener; empty to remove it.
+  void set_batch_listener(std::function<void()> listener);
   // Stores a scene package (already parsed and validated by the caller) under its hash, so
   // jobs may name it by scene_hash.
   void store_scene(const std::string& scene_hash, const v1::ScenePackage& package);
@@ -128,7 +155,7 @@ class Coordinator {
   };
   using Notifications = std::vector<std::function<void()>>;
 
-  v1::SubmitJobResponse submit_spec(v1::JobSpec spec);
+  v1::SubmitJobResponse submit_spec(v1::JobSpec spec, bool awaits_pass_count = false);
   uint64_t parse_job_id(const std::string& job_id) const;
   Job& job_locked(const std::string& job_id);
   Worker& worker_locked(const std::string& worker_id);
@@ -139,6 +166,10 @@ class Coordinator {
   void finish(Job& job);
   void end_job(Job& job, v1::JobState state, const std::string& error);
   void load_reference(Job& job);
+  bool waits_for_pass_count(const Job& job) const;
+  // The job's record as the store holds it: sealed blocks and their compute seconds up to the
+  // last checkpoint.
+  JobRecord durable_record(const Job& job) const;
   v1::JobStatus status_locked(const Job& job, bool with_curve) const;
   TileRect task_tile(const Job& job, uint64_t task_index) const;
   std::pair<uint32_t, uint32_t> task_passes(const Job& job, uint64_t task_index) const;
@@ -156,6 +187,7 @@ class Coordinator {
   std::map<std::string, Worker> workers_;
   uint64_t next_worker_ = 1;
   std::map<uint64_t, std::pair<uint64_t, std::function<void()>>> subscriptions_;
+  std::function<void()> batch_listener_;
   uint64_t next_subscription_ = 1;
   CoordinatorCounters counters_;  // under mutex_; gauges filled in by counters()
 

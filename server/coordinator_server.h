@@ -27,9 +27,9 @@ struct CoordinatorServerOptions {
   // Called on the builder after the services are registered and before it starts: interceptors
   // (authentication), further services, channel arguments.
   std::vector<std::function<void(grpc::ServerBuilder&)>> configure;
-  // The share of each batch method's budget its calibration job renders for
+  // The share of each batch method's budget an equal-time job's calibration renders for
   // (server/batch_manager.h).
-  double batch_calibration_share = 0.08;
+  double batch_calibration_share = 0.05;
 };
 
 class CoordinatorServer {
