@@ -1,9 +1,9 @@
 #pragma once
 // The `penumbra/batch@1` format (batches/README.md): an equal-time comparison of several methods
-// on one scene, run by the farm's coordinator as a set of jobs (a reference, a calibration pass
-// per method, then one job per method, budget and repeat). This is the reader only: no network,
-// no filesystem. Errors are FormatError (core/scene/scene.h) naming the JSON path, the source and
-// the bad value, like the scene reader's.
+// on one scene, run by the farm's coordinator as a set of jobs (a reference, then one job per
+// method, budget and repeat; an equal-time job calibrates itself on its first passes). This is
+// the reader only: no network, no filesystem. Errors are FormatError (core/scene/scene.h) naming
+// the JSON path, the source and the bad value, like the scene reader's.
 //
 //   {"format": "penumbra/batch@1", "name": "fig1-monoliths", "scene": "monoliths",
 //    "methods": [{"method": "line-sa:v", "sampler": "stratified", "label": "ours"}, "sa"],
