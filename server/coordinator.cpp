@@ -474,14 +474,13 @@ void Coordinator::seal_ready_blocks(Job& job) {
         spdlog::warn("{}: no MRSE: {}", job_name(job.record.id), error.what());
       }
     }
-    // A checkpoint writes the merged sums and drops the task results they hold, once
-    // checkpoint_blocks sealed blocks have piled up, unless the job ends sooner (its end drops
-    // them all).
+    // A checkpoint writes the merged sums and drops the task results they hold, once `every`
+    // sealed blocks have piled up, unless the job ends sooner (its end drops them all).
+    const uint32_t every = std::max<uint32_t>(options_.checkpoint_blocks, 1);
     const uint32_t piled_up = job.record.blocks_sealed - job.durable_blocks;
-    const bool ends_soon = !job.seconds_budget() &&
-                           job.total_blocks - job.record.blocks_sealed < options_.checkpoint_blocks;
-    const bool checkpoint = piled_up >= std::max<uint32_t>(options_.checkpoint_blocks, 1) &&
-                            !(ends_soon && piled_up > 1);
+    const bool ends_soon =
+        !job.seconds_budget() && job.total_blocks - job.record.blocks_sealed < every;
+    const bool checkpoint = piled_up >= every && (every == 1 || !ends_soon);
     try {
       if (checkpoint) {
         std::map<uint32_t, std::string> tiles;
