@@ -85,6 +85,7 @@ BatchManager::BatchManager(Coordinator& coordinator, SceneParser parser,
     if (!is_terminal(batch->stored.status().state()))
       spdlog::info("{}: resumed ({})", batch->stored.status().batch_id(),
                    v1::BatchState_Name(batch->stored.status().state()));
+    cancel_unknown_jobs(*batch);
     batches_[number] = std::move(batch);
   }
   coordinator_.set_batch_listener([wakeup = wakeup_] { wakeup->notify(); });
@@ -615,6 +616,20 @@ bool BatchManager::next_pass_count(Batch& batch, v1::BatchMethodStatus& method, 
     spdlog::warn("{}: no pass count given ({}); trying again", run.job_id(), error.what());
   }
   return changed;
+}
+
+// A coordinator killed after submitting a batch's runs but before the batch was stored leaves
+// jobs the stored batch does not name: the batch submits its runs again, and an equal-time job
+// among the first ones would wait for a pass count forever. Cancelled when the batch is loaded.
+void BatchManager::cancel_unknown_jobs(const Batch& batch) {
+  const std::vector<std::string> known = job_ids(batch);
+  const std::string& batch_id = batch.stored.status().batch_id();
+  for (const std::string& job : coordinator_.unfinished_jobs_in_batch(batch_id)) {
+    if (std::find(known.begin(), known.end(), job) != known.end()) continue;
+    spdlog::warn("{}: {} was submitted before a restart but never recorded; cancelled", batch_id,
+                 job);
+    coordinator_.cancel(job);
+  }
 }
 
 std::vector<std::string> BatchManager::job_ids(const Batch& batch) const {

@@ -117,6 +117,7 @@ class BatchManager {
   std::string reference_cache_key(const Batch& batch) const;
   void fail(Batch& batch, const std::string& error);
   void finish(Batch& batch, v1::BatchState state);
+  void cancel_unknown_jobs(const Batch& batch);
   std::vector<std::string> job_ids(const Batch& batch) const;
   v1::BatchStatus status_locked(const Batch& batch, bool with_curves);
   void changed_locked();

@@ -783,6 +783,15 @@ std::vector<v1::JobStatus> Coordinator::list() {
   return result;
 }
 
+std::vector<std::string> Coordinator::unfinished_jobs_in_batch(const std::string& batch_id) {
+  std::lock_guard lock(mutex_);
+  std::vector<std::string> result;
+  for (const auto& [id, job] : jobs_)
+    if (job->spec().batch_id() == batch_id && !is_terminal(job->record.state))
+      result.push_back(job_name(job->record.id));
+  return result;
+}
+
 v1::JobState Coordinator::cancel(const std::string& job_id) {
   Notifications notifications;
   v1::JobState state;

@@ -110,6 +110,8 @@ class Coordinator {
   void store_scene(const std::string& scene_hash, const v1::ScenePackage& package);
   v1::JobStatus status(const std::string& job_id, bool with_curve = true);
   std::vector<v1::JobStatus> list();
+  // The ids of the batch's jobs (submit_in_batch) that have not ended.
+  std::vector<std::string> unfinished_jobs_in_batch(const std::string& batch_id);
   v1::JobState cancel(const std::string& job_id);
   std::string result_exr(const std::string& job_id);
   // The finished job's image (decoded from its EXR).

@@ -10,8 +10,10 @@
 
 #include "penumbra/version.h"
 #include "proto/support/scene_packing.h"
+#include "server/batch_manager.h"
 #include "server/coordinator.h"
 #include "server/store.h"
+#include "tests/batch/batch_test_support.h"
 #include "tests/farm/farm_test_support.h"
 
 namespace penumbra::farm {
@@ -283,6 +285,50 @@ TEST_F(CalibratedRunTest, SealedBlocksBetweenCheckpointsAreMergedAgainAfterARest
   EXPECT_EQ(tasks_completed_, 6u * 20);
   EXPECT_TRUE(testing::same_bits(coordinator->result_film(job).color,
                                  plain_job_film(*coordinator, 40).color));
+}
+
+// A coordinator killed after a batch submitted its runs but before the batch was stored leaves
+// jobs the stored batch never names (the batch then submits its runs again): the batch manager
+// cancels them when it loads the batch, so that an equal-time job among them does not wait for
+// a pass count forever. The jobs the batch does name are left alone.
+TEST_F(CalibratedRunTest, JobsABatchNeverRecordedAreCancelledWhenItIsLoaded) {
+  auto coordinator = make();
+  BatchManagerOptions batch_options;
+  batch_options.data_dir = options_.data_dir;
+  batch_options.poll = 10ms;
+  auto manager = std::make_unique<BatchManager>(*coordinator, parse_wire_package, batch_options);
+  const std::string spec_json = R"({"format": "penumbra/batch@1", "name": "orphans", "scene": ")" +
+                                scene_path_ + R"(", "methods": ["sa", "area"],
+    "budget": {"seconds": 10}, "reference": {"method": "sa", "spp": 2}})";
+  const std::string batch_id =
+      manager->submit(testing::batch_request(dir_, spec_json), "tester").batch_id();
+  // The reference renders; then the batch submits its equal-time runs and stores them.
+  v1::BatchStatus status;
+  for (int round = 0; round < 500; ++round) {
+    work(*coordinator);
+    status = manager->status(batch_id, false);
+    if (status.methods_size() == 2 && status.methods(0).runs_size() > 0 &&
+        status.methods(1).runs_size() > 0)
+      break;
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_GT(status.methods(1).runs_size(), 0) << v1::BatchState_Name(status.state());
+  const std::string known = status.methods(0).runs(0).job_id();
+  manager.reset();
+
+  // What a killed coordinator could leave: a waiting run of this batch that it never recorded.
+  v1::JobSpec spec = testing::job_spec(scene_path_, "sa", 1, 5, 16, 2);
+  spec.set_compute_seconds(0.05);
+  const std::string orphan = coordinator->submit_in_batch(spec, batch_id, true).job_id();
+  work(*coordinator);
+  ASSERT_TRUE(coordinator->awaits_pass_count(orphan));
+
+  manager = std::make_unique<BatchManager>(*coordinator, parse_wire_package, batch_options);
+  EXPECT_EQ(coordinator->status(orphan, false).state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_NE(coordinator->status(known, false).state(), v1::JOB_STATE_CANCELLED);
+  const std::vector<std::string> unfinished = coordinator->unfinished_jobs_in_batch(batch_id);
+  EXPECT_EQ(std::count(unfinished.begin(), unfinished.end(), orphan), 0);
+  manager.reset();
 }
 
 }  // namespace

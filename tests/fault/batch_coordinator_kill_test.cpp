@@ -46,10 +46,11 @@ TEST(FaultBatchCoordinatorKill, RandomKillsDuringABatchLoseNothing) {
   };
 
   // Each kill comes after 1-64 more passes sealed since the last start with a job of the batch
-  // part-way (the reference seals 8 passes per task, the runs 1). The batch has 576 passes
-  // (reference 256, runs 2 x (32 + 128)); 5 kills use at most 5 x 64 of them plus a task or two
-  // per kill sealed while the test looked, so the batch outlasts the kills on any machine and
-  // they fall in the reference and in the runs.
+  // part-way (the reference seals 8 passes per block; a run about a quarter of its passes: 8 for
+  // 32 spp, 32 for 128). The batch has 576 passes (reference 256, runs 2 x (32 + 128)); 5 kills
+  // use at most 5 x (64 + 32) of them, a block or two per kill sealed while the test looked
+  // included, so the batch outlasts the kills on any machine and they fall in the reference and
+  // in the runs.
   std::mt19937 random(1907);
   const int wanted_kills = 5;
   // The batch's state, asked at most every 50 ms (a new channel each time: it survives restarts).
