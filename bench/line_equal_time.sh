@@ -10,7 +10,7 @@
 #   bench/line_equal_time.sh [--build DIR] [--seconds S] [--reference-seconds R]
 #                            [--threads N] [--scenes "a b"] [--out DIR]
 #
-# Defaults: build-lines2, 5 s per method, 120 s reference, 1 thread, both scenes, output in
+# Defaults: build/release, 5 s per method, 120 s reference, 1 thread, both scenes, output in
 # DIR/line_equal_time. Use --seconds 1 for a quick run. The reference (bsdf+sa, seed 99) is
 # cached in the output folder under a name holding the scene file's hash and its budget, so it
 # is rendered once per scene version. The budget is CPU time summed over threads (one thread by
@@ -19,7 +19,7 @@
 # (spp of bsdf+sa / spp of the reference) to every figure.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-build="$root/build-lines2"
+build="$root/build/release"
 seconds=5
 reference_seconds=120
 threads=1

@@ -5,12 +5,17 @@
 # + LeakSanitizer, two at a time, each counted as one test. Ends with one line
 # "N passed, N failed". Installs what it needs first (Debian 12, as root).
 #   PENUMBRA_SKIP_SANITIZE=1  skip the sanitizer pass and the fuzzing (quick local runs)
-#   PENUMBRA_FUZZ_SECONDS=N   seconds per fuzz target (default 60; 0 skips the fuzzing)
+#   PENUMBRA_FUZZ_SECONDS=N   seconds per fuzz target (default 30; 0 skips the fuzzing)
 #   PENUMBRA_JOBS=N           build jobs (default: cores)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh || { echo "setup failed"; exit 1; }
 jobs=${PENUMBRA_JOBS:-$(nproc)}
+fuzz_seconds=${PENUMBRA_FUZZ_SECONDS:-30}
+started=$SECONDS
+# Elapsed time since the start, printed with each phase (the whole command must stay well under
+# 30 minutes on CI's 2 cores).
+elapsed() { printf '[%dm%02ds]' $(((SECONDS - started) / 60)) $(((SECONDS - started) % 60)); }
 passed=0
 failed=0
 status=0
@@ -18,14 +23,14 @@ status=0
 run_suite() {  # name build-dir ctest-exclude-regex cmake-args...
   local name=$1 dir=$2 exclude=$3
   shift 3
-  echo "== $name: configure and build ($dir)"
+  echo "== $(elapsed) $name: configure and build ($dir)"
   if ! cmake -S . -B "$dir" -G Ninja "$@" >"$dir.configure.log" 2>&1; then
     cat "$dir.configure.log"; echo "$name: configure failed"; failed=$((failed + 1)); status=1; return
   fi
   if ! ninja -C "$dir" -j "$jobs" >"$dir.build.log" 2>&1; then
     tail -n 60 "$dir.build.log"; echo "$name: build failed"; failed=$((failed + 1)); status=1; return
   fi
-  echo "== $name: ctest"
+  echo "== $(elapsed) $name: ctest"
   local log="$dir.ctest.log"
   local filter=()
   [ -n "$exclude" ] && filter=(-E "$exclude")
@@ -53,7 +58,7 @@ run_fuzzers() {  # build-dir seconds
   if [ "${#targets[@]}" = 0 ]; then
     echo "fuzzing: no fuzz_* programs in $dir/fuzz"; failed=$((failed + 1)); status=1; return
   fi
-  echo "== fuzzing: ${#targets[@]} targets, ${seconds} s each, 2 at a time"
+  echo "== $(elapsed) fuzzing: ${#targets[@]} targets, ${seconds} s each, 2 at a time"
   rm -rf "$dir/fuzz-work" "$dir/fuzz-artifacts"
   mkdir -p "$dir/fuzz-work" "$dir/fuzz-artifacts"
   local running=0
@@ -99,13 +104,13 @@ if [ "${PENUMBRA_SKIP_SANITIZE:-0}" != 1 ]; then
   # for gcc 12 and clang 14 lacks some of its C++20 (capturing structured bindings in lambdas
   # broke core/report once), so a new file could break a clang pass. The fuzzers get a small
   # clang tree of their own that builds only them and the libraries they test.
-  if [ "${PENUMBRA_FUZZ_SECONDS:-60}" != 0 ]; then
-    echo "== fuzz targets: configure and build (build/fuzz, clang)"
+  if [ "$fuzz_seconds" != 0 ]; then
+    echo "== $(elapsed) fuzz targets: configure and build (build/fuzz, clang)"
     if CC=clang CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
          -DPENUMBRA_SANITIZE=ON -DPENUMBRA_FUZZ=ON -DPENUMBRA_FARM=OFF -DPENUMBRA_BENCH=OFF \
          -DPENUMBRA_TESTS=OFF >build/fuzz.configure.log 2>&1 &&
        ninja -C build/fuzz -j "$jobs" fuzzers >build/fuzz.build.log 2>&1; then
-      run_fuzzers build/fuzz "${PENUMBRA_FUZZ_SECONDS:-60}"
+      run_fuzzers build/fuzz "$fuzz_seconds"
     else
       tail -n 60 build/fuzz.configure.log build/fuzz.build.log; echo "fuzz targets: build failed"
       failed=$((failed + 1)); status=1
@@ -114,5 +119,6 @@ if [ "${PENUMBRA_SKIP_SANITIZE:-0}" != 1 ]; then
     echo "== fuzzing skipped (PENUMBRA_FUZZ_SECONDS=0)"
   fi
 fi
+echo "== $(elapsed) done"
 echo "$passed passed, $failed failed"
 exit $status
