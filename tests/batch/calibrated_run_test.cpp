@@ -8,34 +8,18 @@
 #if __has_include("penumbra/v1/farm.pb.h")
 #include <gtest/gtest.h>
 
-#include "penumbra/version.h"
 #include "proto/support/scene_packing.h"
 #include "server/batch_manager.h"
 #include "server/coordinator.h"
 #include "server/store.h"
 #include "tests/batch/batch_test_support.h"
+#include "tests/farm/fake_worker.h"
 #include "tests/farm/farm_test_support.h"
 
 namespace penumbra::farm {
 namespace {
 
 using namespace std::chrono_literals;
-
-// The radiance the fake worker "renders" for pixel (x, y) in pass p (exactly representable).
-Rgb fake_radiance(int x, int y, uint32_t pass) {
-  return {double(x % 7) * 0.25 + pass * 0.5, double(y % 5) * 0.125, double((x + y + pass) % 3)};
-}
-
-TileAccumulator fake_render(const v1::Task& task) {
-  TileRect rect{task.tile().x0(), task.tile().y0(), task.tile().x1(), task.tile().y1()};
-  TileAccumulator tile(rect);
-  for (int y = rect.y0; y < rect.y1; ++y)
-    for (int x = rect.x0; x < rect.x1; ++x)
-      for (uint32_t pass = task.pass_begin(); pass < task.pass_end(); ++pass)
-        tile.add_sample(int64_t(y - rect.y0) * rect.width() + (x - rect.x0),
-                        fake_radiance(x, y, pass));
-  return tile;
-}
 
 constexpr double kTaskSeconds = 0.01;  // what every fake task reports
 
@@ -51,30 +35,14 @@ class CalibratedRunTest : public ::testing::Test {
 
   std::unique_ptr<Coordinator> make() {
     auto coordinator = std::make_unique<Coordinator>(options_, parse_wire_package);
-    v1::RegisterRequest request;
-    request.set_name("fake");
-    request.set_threads(1);
-    request.set_build_flavour(kBuildFlavour);
-    request.set_protocol_version(v1::PROTOCOL_VERSION_CURRENT);
-    worker_ = coordinator->register_worker(request).worker_id();
+    worker_ = testing::register_fake_worker(*coordinator, "fake");
     return coordinator;
   }
   std::vector<v1::Task> lease(Coordinator& coordinator, uint32_t n = 1000) {
-    v1::LeaseTasksRequest request;
-    request.set_worker_id(worker_);
-    request.set_max_tasks(n);
-    auto response = coordinator.lease_tasks(request);
-    return {response.tasks().begin(), response.tasks().end()};
+    return testing::lease_tasks(coordinator, worker_, n);
   }
   void complete(Coordinator& coordinator, const v1::Task& task) {
-    v1::CompleteTaskRequest request;
-    request.set_worker_id(worker_);
-    request.set_job_id(task.job_id());
-    request.set_task_index(task.task_index());
-    request.set_attempt_token(task.attempt_token());
-    request.set_tile(fake_render(task).serialize());
-    request.set_compute_seconds(kTaskSeconds);
-    ASSERT_TRUE(coordinator.complete_task(request));
+    ASSERT_TRUE(testing::complete_fake_task(coordinator, worker_, task, kTaskSeconds));
     ++tasks_completed_;
   }
   // Leases and completes tasks, `limit` at most, until nothing is left to lease.

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <thread>
 
+#include "fake_worker.h"
 #include "farm_test_support.h"
-#include "penumbra/version.h"
 #include "proto/support/scene_packing.h"
 
 namespace penumbra::farm {
@@ -18,21 +18,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// The radiance a fake worker "renders" for pixel (x, y) in pass p (exactly representable).
-Rgb fake_radiance(int x, int y, uint32_t pass) {
-  return {double(x % 7) * 0.25 + pass * 0.5, double(y % 5) * 0.125, double((x + y + pass) % 3)};
-}
-
-TileAccumulator fake_render(const v1::Task& task) {
-  TileRect rect{task.tile().x0(), task.tile().y0(), task.tile().x1(), task.tile().y1()};
-  TileAccumulator tile(rect);
-  for (int y = rect.y0; y < rect.y1; ++y)
-    for (int x = rect.x0; x < rect.x1; ++x)
-      for (uint32_t pass = task.pass_begin(); pass < task.pass_end(); ++pass)
-        tile.add_sample(int64_t(y - rect.y0) * rect.width() + (x - rect.x0),
-                        fake_radiance(x, y, pass));
-  return tile;
-}
+using testing::fake_radiance;
+using testing::fake_render;
 
 Film expected_film(int width, int height, uint32_t spp) {
   std::vector<TileAccumulator> tiles;
@@ -59,30 +46,14 @@ class CoordinatorTest : public ::testing::Test {
     return std::make_unique<Coordinator>(options_, parse_wire_package);
   }
   std::string register_worker(Coordinator& coordinator, const std::string& name) {
-    v1::RegisterRequest request;
-    request.set_name(name);
-    request.set_threads(1);
-    request.set_build_flavour(kBuildFlavour);
-    request.set_protocol_version(v1::PROTOCOL_VERSION_CURRENT);
-    return coordinator.register_worker(request).worker_id();
+    return testing::register_fake_worker(coordinator, name);
   }
   std::vector<v1::Task> lease(Coordinator& coordinator, const std::string& worker, uint32_t n) {
-    v1::LeaseTasksRequest request;
-    request.set_worker_id(worker);
-    request.set_max_tasks(n);
-    auto response = coordinator.lease_tasks(request);
-    return {response.tasks().begin(), response.tasks().end()};
+    return testing::lease_tasks(coordinator, worker, n);
   }
   bool complete(Coordinator& coordinator, const std::string& worker, const v1::Task& task,
                 double seconds = 0.01) {
-    v1::CompleteTaskRequest request;
-    request.set_worker_id(worker);
-    request.set_job_id(task.job_id());
-    request.set_task_index(task.task_index());
-    request.set_attempt_token(task.attempt_token());
-    request.set_tile(fake_render(task).serialize());
-    request.set_compute_seconds(seconds);
-    return coordinator.complete_task(request);
+    return testing::complete_fake_task(coordinator, worker, task, seconds);
   }
   v1::JobSpec spec(uint32_t spp) {
     // tiles of 16: 40x24 -> 3 x 2 = 6 tiles; 4 passes per task.
