@@ -178,15 +178,15 @@ Vec3 absolute(const Vec3& v) {
 // radius] contains the exact range of f over the box. Their constants are floats, computed
 // once per query.
 
-// The three functions, in this order, in lanes 0-2 of the set-up's arrays.
+// The three functions, in this order, index the set-up's arrays.
 enum Function { kDistance = 0, kAlpha = 1, kBeta = 2 };
 
 // Everything the node test needs from one query.
 struct NodeTestSetup {
-  float region_lower[4], region_upper[4];  // bounding box of the crossing region (lanes 0-2)
-  float gradient[3][4];                    // [axis][function]
-  float magnitude[3][4];                   // |gradient|
-  float offset[4], error[4];               // [function]
+  float region_lower[3], region_upper[3];  // bounding box of the crossing region
+  float gradient[3][3];                    // [axis][function]
+  float magnitude[3][3];                   // |gradient|
+  float offset[3], error[3];               // [function]
   // Depth s = alpha + beta: its range over a box lies within the sum of theirs, widened by
   // depth_error (the rounding of the two extra sums; see set_up_node_test).
   float depth_error;
