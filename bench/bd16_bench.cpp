@@ -23,6 +23,8 @@
 namespace penumbra {
 namespace {
 
+using namespace occluder_meshes;
+
 struct Fixture {
   Light light = make_quad_light({-0.5, -0.5, 2}, {1, 0, 0}, {0, -1, 0}, {5, 5, 5});
   TriangleMesh mesh;

@@ -2,7 +2,9 @@
 //
 // Scenes (PERFORMANCE.md): S1 cornell-occluders (scenes/cornell-occluders.json, or a Cornell
 // box with 20 floating boxes built here when the file is missing or does not load); S3 = S1 plus
-// a ~1M-triangle UV sphere; S2 = S1 plus 1M small random triangles. Shading points are the first
+// a ~1M-triangle UV sphere; S2 = S1 plus 1M small random triangles; the kitchen
+// (../shared/peer-scenes/kitchen/kitchen-play.pbrt, 1.44M triangles, its window light; skipped
+// when absent). Shading points are the first
 // hits of camera rays (Embree rtcIntersect1) that face the light; per shading point 16 random
 // light samples: a point on the quad light for the shadow ray (rtcOccluded1, tnear/tfar set to
 // the line query's own tolerances) and a line along edge1 at a random offset for the line query.
@@ -14,6 +16,8 @@
 // Run: build-*/bench/line_query_bench [--benchmark_filter=S1] [--benchmark_repetitions=5]
 //      [--bundled]     (also every bundled scene with a quad light: shadow_ray and
 //                       line_query_medium on scene:<file stem>, e.g. --benchmark_filter=scene:)
+//      [--scene=PATH]  (also any scene file, e.g. a pbrt-v3 file: shadow_ray and
+//                       line_query_medium on file:<path>)
 //      [--queries=N]   (a fixed number of iterations per benchmark: repeatable instruction
 //                       counts under callgrind, e.g.
 //   valgrind --tool=callgrind --toggle-collect='penumbra::LineQuery::visible_intervals*'
@@ -43,6 +47,8 @@
 
 namespace penumbra {
 namespace {
+
+using namespace occluder_meshes;
 
 struct QuadLight {
   Vec3 origin, edge1, edge2;
@@ -121,12 +127,7 @@ BenchScene with_random_triangles() {
   return scene;
 }
 
-// A bundled scene by file stem ("scene:<stem>"): its triangles, first quad light and camera.
-BenchScene bundled_scene(const std::string& stem) {
-  BenchScene scene;
-  scene.name = "scene:" + stem;
-  scene.description = "scenes/" + stem + ".json";
-  Scene loaded = load_scene(std::string(PENUMBRA_SOURCE_DIR) + "/" + scene.description);
+BenchScene from_loaded(BenchScene scene, const Scene& loaded) {
   for (const Light& light : loaded.lights) {
     if (light.type != LightType::Quad) continue;
     scene.mesh.positions = loaded.positions;
@@ -138,8 +139,36 @@ BenchScene bundled_scene(const std::string& stem) {
   throw std::runtime_error(scene.description + " has no quad light");
 }
 
+// A bundled scene by file stem ("scene:<stem>"), or any scene file by its path ("file:<path>",
+// e.g. a pbrt-v3 file): its triangles, first quad light and camera.
+BenchScene bundled_scene(const std::string& stem) {
+  BenchScene scene;
+  scene.name = "scene:" + stem;
+  scene.description = "scenes/" + stem + ".json";
+  Scene loaded = load_scene(std::string(PENUMBRA_SOURCE_DIR) + "/" + scene.description);
+  return from_loaded(std::move(scene), loaded);
+}
+
+BenchScene file_scene(const std::string& path) {
+  BenchScene scene;
+  scene.name = "file:" + path;
+  scene.description = path;
+  return from_loaded(std::move(scene), load_scene(path));
+}
+// The papers' kitchen (1.44M triangles, a window light), when ../shared/peer-scenes is there.
+std::string kitchen_path() {
+  return std::string(PENUMBRA_SOURCE_DIR) + "/../shared/peer-scenes/kitchen/kitchen-play.pbrt";
+}
+
 BenchScene make_scene(const std::string& name) {
+  if (name == "kitchen") {
+    BenchScene scene = file_scene(kitchen_path());
+    scene.name = name;
+    scene.description = "peer-scenes/kitchen/kitchen-play.pbrt";
+    return scene;
+  }
   if (name.rfind("scene:", 0) == 0) return bundled_scene(name.substr(6));
+  if (name.rfind("file:", 0) == 0) return file_scene(name.substr(5));
   if (name == "S3") return with_sphere();
   if (name == "S2") return with_random_triangles();
   return cornell_occluders();
@@ -413,10 +442,13 @@ int main(int argc, char** argv) {
   // (line_query_medium only). Removed before Google Benchmark parses the rest.
   long fixed_iterations = 0;
   bool bundled = false;
+  std::vector<std::string> files;  // --scene=PATH: any scene file (JSON or pbrt-v3)
   for (int i = 1; i < argc; ++i) {
     std::string argument(argv[i]);
     if (argument == "--bundled") {
       bundled = true;
+    } else if (argument.rfind("--scene=", 0) == 0) {
+      files.push_back(argument.substr(8));
     } else if (argument.rfind("--queries=", 0) == 0) {
       fixed_iterations = std::stol(argument.substr(10));
     } else {
@@ -434,20 +466,29 @@ int main(int argc, char** argv) {
   _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
   _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
   RatioReporter reporter;
-  for (const char* scene : {"S1", "S3", "S2"}) {
-    std::string name(scene);
+  // A scene's shadow-ray and line-query benchmarks (the High build too when asked), in the
+  // ratio summary.
+  auto register_scene = [&](const std::string& name, bool high) {
     reporter.scenes.push_back(name);
     fix(benchmark::RegisterBenchmark(
-        (std::string("shadow_ray/") + name).c_str(),
+        ("shadow_ray/" + name).c_str(),
         [name](benchmark::State& state) { shadow_rays(state, name); }));
-    fix(benchmark::RegisterBenchmark((std::string("line_query_medium/") + name).c_str(),
+    fix(benchmark::RegisterBenchmark(("line_query_medium/" + name).c_str(),
                                      [name](benchmark::State& state) {
                                        line_queries(state, name, LineQueryBuildQuality::Medium);
                                      }));
-    fix(benchmark::RegisterBenchmark((std::string("line_query_high/") + name).c_str(),
-                                     [name](benchmark::State& state) {
-                                       line_queries(state, name, LineQueryBuildQuality::High);
-                                     }));
+    if (high)
+      fix(benchmark::RegisterBenchmark(("line_query_high/" + name).c_str(),
+                                       [name](benchmark::State& state) {
+                                         line_queries(state, name, LineQueryBuildQuality::High);
+                                       }));
+  };
+  for (const char* scene : {"S1", "S3", "S2"}) register_scene(scene, true);
+  if (std::filesystem::exists(kitchen_path())) {
+    register_scene("kitchen", false);
+  } else {
+    std::fprintf(stderr, "line_query_bench: %s is absent: no kitchen benchmarks\n",
+                 kitchen_path().c_str());
   }
   if (bundled) {
     std::vector<std::string> stems;
@@ -455,22 +496,9 @@ int main(int argc, char** argv) {
          std::filesystem::directory_iterator(std::string(PENUMBRA_SOURCE_DIR) + "/scenes"))
       if (entry.path().extension() == ".json") stems.push_back(entry.path().stem().string());
     std::sort(stems.begin(), stems.end());
-    for (const std::string& stem : stems) {
-      std::string name = "scene:" + stem;
-      reporter.scenes.push_back(name);
-      fix(benchmark::RegisterBenchmark(
-          ("shadow_ray/" + name).c_str(),
-          [name](benchmark::State& state) { shadow_rays(state, name); }));
-      fix(benchmark::RegisterBenchmark(("line_query_medium/" + name).c_str(),
-                                       [name](benchmark::State& state) {
-                                         line_queries(state, name, LineQueryBuildQuality::Medium);
-                                       }));
-      fix(benchmark::RegisterBenchmark(("line_query_high/" + name).c_str(),
-                                       [name](benchmark::State& state) {
-                                         line_queries(state, name, LineQueryBuildQuality::High);
-                                       }));
-    }
+    for (const std::string& stem : stems) register_scene("scene:" + stem, true);
   }
+  for (const std::string& path : files) register_scene("file:" + path, false);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks(&reporter);

@@ -12,8 +12,8 @@
 #include <random>
 #include <vector>
 
-#include "core/polygon/ltc_strategy.h"
-#include "core/polygon/psa_strategy.h"
+#include "core/strategies/ltc_strategy.h"
+#include "core/strategies/psa_strategy.h"
 
 namespace penumbra {
 namespace {

@@ -21,12 +21,11 @@
 
 #include "core/math/vec.h"
 #include "core/polygon/arvo_solid_angle.h"
-#include "core/polygon/ltc_strategy.h"
-#include "core/polygon/peters_sa_strategy.h"
 #include "core/polygon/projected_solid_angle.h"
-#include "core/polygon/psa_strategy.h"
 #include "core/polygon/solid_angle_polygon.h"
 #include "core/strategies/area_strategy.h"
+#include "core/strategies/ltc_strategy.h"
+#include "core/strategies/psa_strategy.h"
 #include "core/strategies/solid_angle_strategy.h"
 
 namespace penumbra {
@@ -195,7 +194,6 @@ void strategy_per_sample(benchmark::State& state, bool central) {
 
 PENUMBRA_STRATEGY_BENCH(area, AreaStrategy, true)
 PENUMBRA_STRATEGY_BENCH(sa, SolidAngleStrategy, true)
-PENUMBRA_STRATEGY_BENCH(sa_polygon, PetersSolidAngleStrategy, true)
 PENUMBRA_STRATEGY_BENCH(psa_central, ProjectedSolidAngleStrategy, true)
 PENUMBRA_STRATEGY_BENCH(psa_decentral, ProjectedSolidAngleStrategy, false)
 PENUMBRA_STRATEGY_BENCH(ltc, LtcStrategy, true)

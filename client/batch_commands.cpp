@@ -21,12 +21,19 @@
 #include <thread>
 
 #include "client/commands.h"
+#include "client/progress.h"
 #include "client/read_file.h"
+#include "client/scene_checks.h"
+#include "core/report/batch_result.h"
 
 #ifdef PENUMBRA_WITH_FARM
 #include "client/connection_options.h"
+#include "client/exact_reference_cache.h"
+#include "core/batch/batch_spec.h"
 #include "core/report/batch_report.h"
 #include "proto/support/batch_client.h"
+#include "proto/support/scene_packing.h"
+#include "proto/support/state_names.h"
 #include "server/embedded_farm.h"
 #endif
 
@@ -54,24 +61,7 @@ std::string bundled_batch_path(const std::string& name) {
 
 namespace {
 
-std::string state_name(v1::BatchState state) {
-  switch (state) {
-    case v1::BATCH_STATE_REFERENCE:
-      return "reference";
-    case v1::BATCH_STATE_CALIBRATING:
-      return "calibrating";
-    case v1::BATCH_STATE_RUNNING:
-      return "running";
-    case v1::BATCH_STATE_DONE:
-      return "done";
-    case v1::BATCH_STATE_FAILED:
-      return "failed";
-    case v1::BATCH_STATE_CANCELLED:
-      return "cancelled";
-    default:
-      return "unknown";
-  }
-}
+using farm::state_name;
 
 std::string progress_line(const v1::BatchStatus& status) {
   char text[256];
@@ -81,26 +71,26 @@ std::string progress_line(const v1::BatchStatus& status) {
   return text;
 }
 
-// Follows the batch with one progress line (rewritten in place on a terminal).
+// Follows the batch: a bar of jobs done with their rate and the ETA, redrawn in place on a
+// terminal; plain lines (at most one per 2 s, and one per phase) otherwise.
 v1::BatchStatus watch_batch(farm::BatchClient& client, const std::string& batch_id) {
-  bool tty = isatty(fileno(stdout));
-  std::string last;
+  ProgressReporter progress(batch_id, ProgressMode::Auto, stdout);
+  std::string phase;
   v1::BatchStatus final_status = client.watch(batch_id, [&](const v1::BatchStatus& status) {
-    std::string line = progress_line(status);
-    // Not a terminal: one line per phase or finished job, not per progress event.
-    std::string key = tty ? line
-                          : status.batch_id() + state_name(status.state()) +
-                                std::to_string(status.jobs_done()) + "/" +
-                                std::to_string(status.jobs_total());
-    if (key == last) return;
-    last = key;
-    if (tty)
-      std::printf("\r%-90s", line.c_str());
-    else
-      std::printf("%s\n", line.c_str());
-    std::fflush(stdout);
+    char extra[160];
+    std::snprintf(extra, sizeof extra, "%s, compute %.1f s, wall %.1f s",
+                  state_name(status.state()).c_str(), status.compute_seconds(),
+                  status.wall_seconds());
+    if (state_name(status.state()) != phase) {
+      if (!phase.empty()) progress.note(batch_id + ": " + state_name(status.state()));
+      phase = state_name(status.state());
+    }
+    // Jobs per wall second of the batch itself (it may have started before this watch).
+    double rate = status.wall_seconds() > 0 ? status.jobs_done() / status.wall_seconds() : 0;
+    progress.update(status.jobs_done(), status.jobs_total(), "jobs", extra, rate, "jobs/s",
+                    status.wall_seconds());
   });
-  if (tty) std::printf("\n");
+  progress.finish();
   return final_status;
 }
 
@@ -144,11 +134,22 @@ void print_status(const v1::BatchStatus& status) {
 void print_summary(const std::filesystem::path& dir) {
   std::ifstream in(dir / "batch.json");
   nlohmann::json index = nlohmann::json::parse(in);
+  try {
+    if (std::string warning = reference_depth_warning(read_batch_result(dir)); !warning.empty())
+      std::fprintf(stderr, "penumbra: warning: %s\n", warning.c_str());
+  } catch (const std::exception&) {
+    // The table below still prints; the report reads the folder again and names any problem.
+  }
   std::vector<std::string> regions = {"image"};
   for (const auto& region : index["regions"]) regions.push_back(region["name"]);
+  // Each MRSE column as wide as its header (never cut: "MRSE penumbra-edge1").
+  std::vector<int> widths;
   std::printf("%-34s %6s %9s", "method", "spp", "compute s");
-  for (const std::string& region : regions)
-    std::printf(" %12s", ("MRSE " + region).substr(0, 12).c_str());
+  for (const std::string& region : regions) {
+    const std::string header = "MRSE " + region;
+    widths.push_back(std::max<int>(12, int(header.size())));
+    std::printf(" %*s", widths.back(), header.c_str());
+  }
   std::printf("\n");
   for (const auto& method : index["methods"]) {
     std::string label = method["label"];
@@ -160,9 +161,10 @@ void print_summary(const std::filesystem::path& dir) {
       if (method["budget_seconds"].is_number() && !run.value("equal_time", true)) continue;
       std::printf("%-34s %6u %9.2f", label.c_str(), run["spp"].get<unsigned>(),
                   run["compute_seconds"].get<double>());
-      for (const std::string& region : regions)
+      for (size_t r = 0; r < regions.size(); ++r)
         for (const auto& error : run["errors"])
-          if (error["region"] == region) std::printf(" %12.4g", error["mrse"].get<double>());
+          if (error["region"] == regions[r])
+            std::printf(" %*.4g", widths[r], error["mrse"].get<double>());
       std::printf("  (r%u)\n", run["repeat"].get<unsigned>());
     }
   }
@@ -171,6 +173,30 @@ void print_summary(const std::filesystem::path& dir) {
 std::string folder_of(const std::string& path) {
   std::string folder = std::filesystem::path(path).parent_path().string();
   return folder.empty() ? "." : folder;
+}
+
+// The scene's warnings printed (refused when the spec says "strict": true) before anything is
+// sent; a batch whose reference is exact: rendered (or read from the cache) here and uploaded
+// with the batch like an EXR reference. Returns the scene's content hash.
+std::string attach_exact_reference(v1::SubmitBatchRequest& request) {
+  BatchSpec spec = parse_batch_spec(request.spec_json(), request.source_name());
+  const Scene scene = farm::parse_wire_package(request.scene());
+  report_scene_warnings(scene, spec.strict, spec.scene);
+  if (spec.reference.kind != BatchReferenceKind::Exact) return scene.content_hash;
+  std::printf("batch: exact reference for %s (%u camera samples per pixel)...\n",
+              scene.name.c_str(), spec.reference.camera_samples);
+  std::fflush(stdout);
+  CachedExactReference reference = exact_reference_for(scene, spec.reference);
+  if (reference.cached)
+    std::printf("batch: exact reference read from the cache %s (%.1f%% of camera samples exact)\n",
+                reference.path.string().c_str(), 100 * reference.exact_share);
+  else
+    std::printf(
+        "batch: exact reference rendered in %.1f compute s (%.1f%% of camera samples exact), "
+        "cached as %s\n",
+        reference.compute_seconds, 100 * reference.exact_share, reference.path.string().c_str());
+  request.set_reference_exr(std::move(reference.exr));
+  return scene.content_hash;
 }
 
 struct SpecArguments {
@@ -195,6 +221,7 @@ std::string run_batch(const std::string& spec_text, const std::string& source_na
                       const BatchRunSettings& settings) {
   v1::SubmitBatchRequest request =
       farm::make_batch_request_from_text(spec_text, source_name, base_dir, bundled_scene_path);
+  const std::string scene_hash = attach_exact_reference(request);
   std::unique_ptr<farm::EmbeddedFarm> embedded;
   farm::FarmConnection connection;
   if (settings.coordinator.empty()) {
@@ -218,7 +245,7 @@ std::string run_batch(const std::string& spec_text, const std::string& source_na
     connection.token = settings.token;
   }
   farm::BatchClient client(connection);
-  v1::SubmitBatchResponse response = client.submit(request);
+  v1::SubmitBatchResponse response = client.upload_and_submit(request, scene_hash);
   std::printf("%s submitted (scene %s)\n", response.batch_id().c_str(),
               response.scene_hash().substr(0, 12).c_str());
   std::fflush(stdout);
@@ -279,8 +306,9 @@ void add_batch_commands(CLI::App& app) {
     if (!std::filesystem::exists(path) && path.find('/') == std::string::npos)
       path = bundled_batch_path(path);
     farm::BatchClient client(connection_of(submit_arguments->connection));
-    v1::SubmitBatchResponse response =
-        client.submit(farm::make_batch_request(path, bundled_scene_path));
+    v1::SubmitBatchRequest request = farm::make_batch_request(path, bundled_scene_path);
+    const std::string scene_hash = attach_exact_reference(request);
+    v1::SubmitBatchResponse response = client.upload_and_submit(request, scene_hash);
     std::printf("%s\n", response.batch_id().c_str());
   });
 
@@ -336,7 +364,10 @@ void add_batch_commands(CLI::App& app) {
   report->add_option("batch", report_arguments->id, "Batch result folder or batch id")->required();
   report->add_option("-o,--output", report_arguments->output, "Output folder")->required();
   add_connection_options(report, report_arguments->connection);
-  report->callback([report_arguments] {
+  auto report_reference = std::make_shared<std::string>();
+  report->add_option("--reference", *report_reference,
+                     "Measure the runs against this EXR instead of the batch's reference");
+  report->callback([report_arguments, report_reference] {
     std::filesystem::path source = report_arguments->id;
     std::filesystem::path out = report_arguments->output;
     if (!std::filesystem::is_directory(source)) {
@@ -344,7 +375,9 @@ void add_batch_commands(CLI::App& app) {
       source = out / "result";
       farm::write_batch_result(client, client.status(report_arguments->id), source);
     }
-    write_batch_report(source, out);
+    BatchReportOptions options;
+    options.reference_exr = *report_reference;
+    write_batch_report(source, out, options);
     std::printf("wrote %s\n", (out / "report.html").string().c_str());
   });
 }

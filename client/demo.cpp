@@ -20,7 +20,7 @@
 #include "client/batch_commands.h"
 #include "client/commands.h"
 #include "core/image/metrics.h"
-#include "core/method/direct_lighting.h"
+#include "core/method/method_check.h"
 #include "core/method/method.h"
 #include "core/render/local_render.h"
 #include "core/scene/scene.h"
@@ -34,9 +34,10 @@ void run_local_demo(const std::string& out_dir, double seconds, int threads) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read the demo batch " + path);
   nlohmann::json spec = nlohmann::json::parse(in);
-  spec["budget"]["seconds"] = seconds;
-  std::printf("demo: batch %s (%s), %.1f s of compute per method\n", path.c_str(),
-              spec.value("scene", std::string()).c_str(), seconds);
+  if (seconds > 0) spec["budget"]["seconds"] = seconds;
+  std::printf("demo: batch %s (%s), %.2f s of compute per method and repeat, %d repeats\n",
+              path.c_str(), spec.value("scene", std::string()).c_str(),
+              spec["budget"].value("seconds", 0.0), spec.value("repeats", 3));
   BatchRunSettings settings;
   settings.workers = threads;
   run_batch(spec.dump(2), path, std::filesystem::path(path).parent_path().string(), out_dir,
@@ -83,7 +84,7 @@ class DemoRenderer {
 
   DemoRender render(const DemoEntry& entry, double seconds, uint64_t seed) {
     // Refuse what the estimator cannot run before it reaches a worker (FormatError).
-    DirectLighting check(*scene_, parse_method(entry.method));
+    check_method_runs_on(*scene_, parse_method(entry.method));
     DemoRender out;
     Renderer renderer(scene_, RenderOptions{entry.method, *parse_pattern(entry.sampler), seed});
     RenderBudget budget;
@@ -103,6 +104,7 @@ class DemoRenderer {
 }  // namespace
 
 void run_local_demo(const std::string& out_dir, double seconds, int threads) {
+  if (!(seconds > 0)) seconds = 4;
   std::filesystem::create_directories(out_dir);
   const std::string scene_path = bundled_scene_path("cornell-occluders");
   auto scene = std::make_shared<const Scene>(load_scene(scene_path));

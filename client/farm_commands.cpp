@@ -16,37 +16,25 @@
 #include <sstream>
 #include <string>
 
+#include "client/cli_options.h"
 #include "client/commands.h"
 #include "client/connection_options.h"
 #include "client/read_file.h"
+#include "client/scene_checks.h"
+#include "core/scene/render_settings.h"
 #include "proto/support/farm_client.h"
 #include "proto/support/scene_packing.h"
+#include "proto/support/state_names.h"
 
 namespace penumbra {
 
 namespace {
 
 using farm::FarmClient;
+using farm::state_name;
 
 FarmClient connect(const ConnectionArguments& arguments) {
   return FarmClient(connection_of(arguments));
-}
-
-std::string state_name(v1::JobState state) {
-  switch (state) {
-    case v1::JOB_STATE_QUEUED:
-      return "queued";
-    case v1::JOB_STATE_RUNNING:
-      return "running";
-    case v1::JOB_STATE_DONE:
-      return "done";
-    case v1::JOB_STATE_FAILED:
-      return "failed";
-    case v1::JOB_STATE_CANCELLED:
-      return "cancelled";
-    default:
-      return "unknown";
-  }
 }
 
 std::string budget_text(const v1::JobStatus& status) {
@@ -63,8 +51,9 @@ double fraction_done(const v1::JobStatus& status) {
   if (status.state() == v1::JOB_STATE_DONE) return 1.0;
   if (status.spp_budget() && status.tasks_total())
     return double(status.tasks_complete()) / double(status.tasks_total());
+  // A spent seconds budget still waits for the tasks in flight: short of 100% until done.
   if (status.seconds_budget() > 0)
-    return std::min(1.0, status.compute_seconds() / status.seconds_budget());
+    return std::min(0.99, status.compute_seconds() / status.seconds_budget());
   return 0.0;
 }
 
@@ -90,6 +79,14 @@ std::string progress_line(const v1::JobStatus& status) {
                 status.tiles_complete(), status.tiles_total(), status.compute_seconds(),
                 status.wall_seconds(), eta.c_str());
   std::string line = text;
+  if (status.wall_seconds() > 0) {
+    // Samples per pixel per wall second so far: the job's rate.
+    std::snprintf(text, sizeof text, "  %.3g spp/s",
+                  status.passes_complete() / status.wall_seconds());
+    line += text;
+  }
+  if (status.tasks_leased() > 0)
+    line += "  leased " + std::to_string(status.tasks_leased());  // rendering, not yet complete
   if (status.has_mrse()) {
     std::snprintf(text, sizeof text, "  MRSE %.4g", status.mrse());
     line += text;
@@ -129,38 +126,68 @@ v1::JobStatus watch_job(FarmClient& client, const std::string& job_id) {
 
 struct SubmitArguments {
   ConnectionArguments connection;
-  std::string scene, method = "sa", sampler = "stratified", reference, name;
+  // Method, sampler and budget left empty/zero take the scene file's own, then Penumbra's
+  // defaults (core/scene/render_settings.h).
+  std::string scene, method, sampler, reference, name;
   uint32_t spp = 0;
   double seconds = 0;
   int priority = 0;
   uint64_t seed = 0;
   uint32_t tile_size = 0, passes_per_task = 0;
-  bool wait = false;
+  bool wait = false, strict = false, accept_reference_mismatch = false;
 };
 
 void submit(const SubmitArguments& arguments) {
-  if ((arguments.spp > 0) == (arguments.seconds > 0))
-    throw std::runtime_error("give exactly one budget: --spp N or --seconds S");
+  if (arguments.spp > 0 && arguments.seconds > 0)
+    throw std::runtime_error(
+        "--spp and --seconds both given: a farm job has one budget, passes (--spp N) or summed "
+        "compute seconds (--seconds S)");
   v1::JobSpec spec;
   *spec.mutable_scene() = farm::pack_scene_file(arguments.scene);
-  spec.set_method(arguments.method);
-  spec.set_sampler(arguments.sampler);
+  // The scene as the coordinator will read it: its warnings now, before anything is sent.
+  const Scene scene = farm::parse_wire_package(spec.scene());
+  report_scene_warnings(scene, arguments.strict, arguments.scene);
+  spec.set_strict(arguments.strict);
+  spec.set_accept_reference_mismatch(arguments.accept_reference_mismatch);
+  RenderSettings settings = {arguments.method, arguments.sampler, arguments.spp, arguments.seconds};
+  if (settings.method.empty() || settings.sampler.empty() ||
+      (settings.spp == 0 && settings.seconds == 0))
+    settings = choose_render_settings(scene, settings);
+  spec.set_method(settings.method);
+  spec.set_sampler(settings.sampler);
   spec.set_seed(arguments.seed);
-  if (arguments.spp > 0)
-    spec.set_spp(arguments.spp);
+  if (settings.seconds > 0)
+    spec.set_compute_seconds(settings.seconds);
   else
-    spec.set_compute_seconds(arguments.seconds);
+    spec.set_spp(settings.spp);
   spec.set_priority(arguments.priority);
   spec.set_tile_size(arguments.tile_size);
   spec.set_passes_per_task(arguments.passes_per_task);
   spec.set_name(arguments.name);
   if (!arguments.reference.empty()) {
-    if (std::filesystem::is_regular_file(arguments.reference))
+    if (std::filesystem::is_regular_file(arguments.reference)) {
       spec.set_reference_exr(read_file(arguments.reference));
-    else
+      // Checked here too, so the refusal names the file (the coordinator checks it again).
+      for (const std::string& warning :
+           check_reference_bytes(spec.reference_exr(), arguments.reference, scene,
+                                 arguments.accept_reference_mismatch))
+        std::fprintf(stderr, "penumbra: warning: %s\n", warning.c_str());
+    } else if (arguments.reference.rfind("job-", 0) == 0) {
       spec.set_reference_job(arguments.reference);
+    } else {
+      throw std::runtime_error("--reference " + arguments.reference +
+                               ": neither an EXR file nor a job id (job-N)");
+    }
   }
   FarmClient client = connect(arguments.connection);
+  // The scene travels in chunks (no message is larger than one, whatever the scene's size) and
+  // only those the coordinator lacks: a submission of the same scene again sends none.
+  const v1::ScenePackage package = spec.scene();
+  spec.set_scene_hash(scene.content_hash);
+  farm::SceneUploadResult upload = client.upload_scene(package, scene.content_hash);
+  if (!upload.already_stored && upload.chunks_total > 0)
+    std::printf("scene %s uploaded: %u of %u chunk(s) sent\n",
+                scene.content_hash.substr(0, 12).c_str(), upload.chunks_sent, upload.chunks_total);
   v1::SubmitJobResponse response = client.submit(spec);
   std::printf("%s submitted (scene %s)\n", response.job_id().c_str(),
               response.scene_hash().substr(0, 12).c_str());
@@ -179,12 +206,24 @@ void print_status(const v1::JobStatus& status) {
               status.sampler().c_str(), static_cast<unsigned long long>(status.seed()),
               status.priority());
   std::printf("budget     %s\n", budget_text(status).c_str());
-  std::printf("progress   %u spp complete of %u planned; tiles %u/%u; tasks %llu/%llu\n",
-              status.passes_complete(), status.passes_planned(), status.tiles_complete(),
-              status.tiles_total(), static_cast<unsigned long long>(status.tasks_complete()),
-              static_cast<unsigned long long>(status.tasks_total()));
+  std::printf(
+      "progress   %u spp complete of %u planned; tiles %u/%u; tasks %llu/%llu (%llu leased)\n",
+      status.passes_complete(), status.passes_planned(), status.tiles_complete(),
+      status.tiles_total(), static_cast<unsigned long long>(status.tasks_complete()),
+      static_cast<unsigned long long>(status.tasks_total()),
+      static_cast<unsigned long long>(status.tasks_leased()));
+  for (const std::string& warning : status.warnings())
+    std::printf("warning    %s\n", warning.c_str());
   std::printf("time       %.2f compute s, %.2f wall s\n", status.compute_seconds(),
               status.wall_seconds());
+  if (status.state() == v1::JOB_STATE_CANCELLED)
+    std::printf("result     %s\n",
+                status.has_result()
+                    ? ("the " + std::to_string(status.passes_complete()) +
+                       " sealed passes: an unbiased image of " +
+                       std::to_string(status.passes_complete()) + " spp (penumbra fetch)")
+                          .c_str()
+                    : "none (cancelled before any pass was sealed)");
   if (status.curve_size()) {
     std::printf("MRSE curve (passes, compute s, wall s, MRSE):\n");
     for (const auto& point : status.curve())
@@ -208,15 +247,30 @@ void add_farm_commands(CLI::App& app) {
   submit_command->add_option("scene", submit_arguments->scene, "Scene file (penumbra/scene@1)")
       ->required()
       ->check(CLI::ExistingFile);
-  submit_command->add_option("--method", submit_arguments->method, "Method (penumbra/method@1)");
-  submit_command->add_option("--sampler", submit_arguments->sampler, "Sample pattern");
-  submit_command->add_option("--spp", submit_arguments->spp, "Budget: samples per pixel");
-  submit_command->add_option("--seconds", submit_arguments->seconds,
-                             "Budget: summed compute seconds (stops at a pass boundary)");
+  submit_command->add_option("--method,-m", submit_arguments->method,
+                             "Method (penumbra/method@1; default: the scene's own, else sa)");
+  submit_command->add_option("--sampler,-s", submit_arguments->sampler,
+                             "Sample pattern (default: the scene's own, else stratified)");
+  submit_command
+      ->add_option("--spp", submit_arguments->spp,
+                   "Budget: samples per pixel (default: the scene's, else 16)")
+      ->check(CLI::Range(1u, 1u << 20));
+  submit_command
+      ->add_option("--seconds", submit_arguments->seconds,
+                   "Budget instead of --spp: summed compute seconds (stops at a pass boundary)")
+      ->check(CLI::Range(1e-3, 1e7));
   submit_command->add_option("--reference", submit_arguments->reference,
-                             "Reference: an EXR file or a job id");
+                             "Reference of the same scene: an EXR file or a job id");
+  submit_command->add_flag("--accept-reference-mismatch",
+                           submit_arguments->accept_reference_mismatch,
+                           "Use a reference of another scene: warn and record it");
+  submit_command->add_flag("--strict", submit_arguments->strict,
+                           "Refuse the scene when its reader warns (unknown keys, ignored "
+                           "parameters)");
   submit_command->add_option("--priority", submit_arguments->priority, "Higher runs first");
-  submit_command->add_option("--seed", submit_arguments->seed, "Random seed");
+  submit_command->add_option("--seed", submit_arguments->seed, "Random seed")
+      ->check(seed_check())
+      ->capture_default_str();
   submit_command->add_option("--tile-size", submit_arguments->tile_size, "Tile side (64)");
   submit_command->add_option("--passes-per-task", submit_arguments->passes_per_task,
                              "Passes in one task (8)");
@@ -253,18 +307,28 @@ void add_farm_commands(CLI::App& app) {
       });
 
   auto cancel_arguments = std::make_shared<JobArguments>();
-  job_command("cancel", "Cancel a job", cancel_arguments)->callback([cancel_arguments] {
-    FarmClient client = connect(cancel_arguments->connection);
-    v1::JobState state = client.cancel(cancel_arguments->job);
-    std::printf("%s %s\n", cancel_arguments->job.c_str(), state_name(state).c_str());
-  });
+  job_command("cancel", "Cancel a job (its sealed passes stay fetchable)", cancel_arguments)
+      ->callback([cancel_arguments] {
+        FarmClient client = connect(cancel_arguments->connection);
+        v1::JobState state = client.cancel(cancel_arguments->job);
+        v1::JobStatus status = client.status(cancel_arguments->job);
+        std::printf("%s %s", cancel_arguments->job.c_str(), state_name(state).c_str());
+        if (state == v1::JOB_STATE_CANCELLED && status.has_result())
+          std::printf("; %u sealed passes kept (penumbra fetch %s -o FILE.exr)",
+                      status.passes_complete(), cancel_arguments->job.c_str());
+        std::printf("\n");
+      });
 
   auto fetch_arguments = std::make_shared<JobArguments>();
   CLI::App* fetch_command = job_command(
-      "fetch", "Download a finished job's EXR (RGB, variance, metadata)", fetch_arguments);
+      "fetch",
+      "Download a job's EXR (RGB, variance, metadata): a done job's, or a cancelled job's "
+      "sealed passes",
+      fetch_arguments);
   fetch_command->add_option("-o,--output", fetch_arguments->output, "Output EXR path")->required();
   fetch_command->callback([fetch_arguments] {
     FarmClient client = connect(fetch_arguments->connection);
+    const v1::JobStatus status = client.status(fetch_arguments->job);
     std::string bytes = client.fetch(fetch_arguments->job);
     std::string temporary = fetch_arguments->output + ".part";
     {
@@ -273,8 +337,9 @@ void add_farm_commands(CLI::App& app) {
       if (!out) throw std::runtime_error("cannot write " + temporary);
     }
     std::filesystem::rename(temporary, fetch_arguments->output);
-    std::printf("%s -> %s (%zu bytes)\n", fetch_arguments->job.c_str(),
-                fetch_arguments->output.c_str(), bytes.size());
+    std::printf("%s -> %s (%zu bytes, %u spp%s)\n", fetch_arguments->job.c_str(),
+                fetch_arguments->output.c_str(), bytes.size(), status.passes_complete(),
+                status.state() == v1::JOB_STATE_CANCELLED ? ", cancelled: its sealed passes" : "");
   });
 
   auto list_connection = std::make_shared<ConnectionArguments>();
@@ -282,9 +347,10 @@ void add_farm_commands(CLI::App& app) {
   add_connection_options(list_command, *list_connection);
   list_command->callback([list_connection] {
     FarmClient client = connect(*list_connection);
+    const std::vector<v1::JobStatus> jobs = client.list();  // a connection error: no header
     std::printf("%-9s %-10s %4s %-20s %-16s %-10s %9s %10s %10s\n", "JOB", "STATE", "PRIO", "SCENE",
                 "METHOD", "BUDGET", "SPP", "COMPUTE s", "MRSE");
-    for (const v1::JobStatus& job : client.list()) {
+    for (const v1::JobStatus& job : jobs) {
       char mrse[32] = "-";
       if (job.has_mrse()) std::snprintf(mrse, sizeof mrse, "%.4g", job.mrse());
       std::printf("%-9s %-10s %4d %-20s %-16s %-10s %9u %10.2f %10s\n", job.job_id().c_str(),
@@ -299,9 +365,10 @@ void add_farm_commands(CLI::App& app) {
   add_connection_options(workers_command, *workers_connection);
   workers_command->callback([workers_connection] {
     FarmClient client = connect(*workers_connection);
+    const std::vector<v1::WorkerInfo> workers = client.workers();
     std::printf("%-24s %-6s %7s %7s %10s %11s %s\n", "WORKER", "ALIVE", "THREADS", "LEASED",
                 "COMPLETED", "COMPUTE s", "LAST SEEN");
-    for (const v1::WorkerInfo& worker : client.workers())
+    for (const v1::WorkerInfo& worker : workers)
       std::printf("%-24s %-6s %7u %7u %10llu %11.2f %.1f s ago\n", worker.worker_id().c_str(),
                   worker.alive() ? "yes" : "no", worker.threads(), worker.tasks_leased(),
                   static_cast<unsigned long long>(worker.tasks_completed()),

@@ -1,18 +1,26 @@
 // Local commands: render, probe and demo run in this process with penumbra_core.
+#include <signal.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <thread>
 
+#include "client/cli_options.h"
 #include "client/commands.h"
+#include "client/progress.h"
 #include "client/read_file.h"
+#include "client/scene_checks.h"
 #include "core/image/metrics.h"
 #include "core/render/local_render.h"
 #include "core/render/probe.h"
+#include "core/scene/render_settings.h"
 #include "core/scene/scene.h"
 
 namespace penumbra {
@@ -42,39 +50,138 @@ std::string png_path_for(const std::string& exr_path) {
 }
 
 struct RenderArgs {
-  std::string scene, method = "sa", sampler = "stratified", output = "out.exr", reference;
-  uint32_t spp = 16;
+  // Method, sampler and budget left empty/zero take the scene file's own, then Penumbra's
+  // defaults (core/scene/render_settings.h).
+  std::string scene, method, sampler, output = "out.exr", reference;
+  uint32_t spp = 0;
   double seconds = 0;
   uint64_t seed = 0;
   int threads = 0;
   int tile = 64;
+  bool quiet = false;
+  bool strict = false, accept_reference_mismatch = false;
+};
+
+// Ctrl-C during a local render: the first asks the render to stop at its next pass boundary (the
+// partial image is written), the second aborts at once.
+std::atomic<bool> stop_render{false};
+std::atomic<int> interrupts{0};
+
+extern "C" void on_render_interrupt(int) {
+  if (interrupts.fetch_add(1) == 0) {
+    stop_render.store(true);
+    const char message[] =
+        "\npenumbra: stopping at the next pass boundary to write the partial image (Ctrl-C "
+        "again to abort)\n";
+    (void)!write(STDERR_FILENO, message, sizeof message - 1);
+    return;
+  }
+  const char message[] = "\npenumbra: aborted\n";
+  (void)!write(STDERR_FILENO, message, sizeof message - 1);
+  signal(SIGINT, SIG_DFL);
+  raise(SIGINT);
+}
+
+// Installs on_render_interrupt for its lifetime.
+class InterruptScope {
+ public:
+  InterruptScope() {
+    stop_render.store(false);
+    interrupts.store(0);
+    struct sigaction action {};
+    action.sa_handler = on_render_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_);
+  }
+  ~InterruptScope() { sigaction(SIGINT, &previous_, nullptr); }
+
+ private:
+  struct sigaction previous_ {};
 };
 
 void run_render(const RenderArgs& args) {
+  // Everything that can be refused is refused before the render: the output, the scene's
+  // warnings under --strict, the reference.
+  const std::string extension = std::filesystem::path(args.output).extension().string();
+  if (extension == ".png" || extension == ".PNG")
+    throw std::runtime_error("-o " + args.output +
+                             ": the output is an EXR (its PNG preview is written beside it); "
+                             "give -o " +
+                             std::filesystem::path(args.output).replace_extension(".exr").string() +
+                             " to get both");
+  check_output_path(args.output, {".exr"}, "-o");
   auto scene = std::make_shared<const Scene>(load_scene(args.scene));
-  RenderOptions options{args.method, sampler_from(args.sampler), args.seed};
+  report_scene_warnings(*scene, args.strict, args.scene);
+  std::optional<CheckedReference> reference;
+  if (!args.reference.empty()) {
+    reference = check_reference(args.reference, *scene, args.accept_reference_mismatch);
+    for (const std::string& warning : reference->warnings)
+      std::fprintf(stderr, "penumbra: warning: %s\n", warning.c_str());
+  }
+  RenderSettings settings =
+      choose_render_settings(*scene, {args.method, args.sampler, args.spp, args.seconds});
+  if (args.spp > 0 && args.seconds > 0)
+    std::fprintf(stderr,
+                 "penumbra: note: --seconds %g with --spp %u: renders until either is reached\n",
+                 args.seconds, args.spp);
+  RenderOptions options{settings.method, sampler_from(settings.sampler), args.seed};
   Renderer renderer(scene, options);
   RenderBudget budget;
-  if (args.seconds > 0)
-    budget.seconds = args.seconds;
-  else
-    budget.spp = args.spp;
-  LocalRenderResult result = render_local(renderer, budget, args.threads, args.tile);
+  if (settings.seconds > 0) {
+    budget.seconds = settings.seconds;
+    if (settings.spp > 0) budget.max_spp = settings.spp;
+  } else {
+    budget.spp = settings.spp;
+  }
+  ProgressReporter progress("render " + scene->name,
+                            args.quiet ? ProgressMode::Quiet : ProgressMode::Auto);
+  const double pixels = double(scene->camera.width) * scene->camera.height;
+  auto report = [&](uint32_t passes, double compute_seconds) {
+    const double wall = progress.elapsed();
+    const double spp_rate = wall > 0 ? passes / wall : 0;
+    char samples[64];
+    std::snprintf(samples, sizeof samples, "%.3g Msamples/s", spp_rate * pixels * 1e-6);
+    if (budget.spp > 0) {
+      progress.update(passes, budget.spp, "spp", samples, spp_rate, "spp/s");
+    } else {
+      char extra[96];
+      std::snprintf(extra, sizeof extra, "%u spp, %s", passes, samples);
+      progress.update(compute_seconds, budget.seconds, "s compute", extra,
+                      wall > 0 ? compute_seconds / wall : 0.0, "compute s/s");
+    }
+  };
+  // Until the image is written, a first Ctrl-C stops the render and a second one aborts.
+  InterruptScope interrupt_scope;
+  LocalRenderResult result =
+      render_local(renderer, budget, args.threads, args.tile, report, &stop_render);
+  progress.finish();
+  if (result.stopped && result.spp == 0)
+    throw std::runtime_error("render interrupted before its first pass: nothing written");
   if (result.film.nonfinite_samples > 0) {
     std::fprintf(stderr, "penumbra: error: %llu non-finite samples (counted as zero)\n",
                  (unsigned long long)result.film.nonfinite_samples);
     exit_code = 3;
   }
   ImageMetadata metadata = render_metadata(*scene, options, result.spp, result.compute_seconds);
+  if (result.stopped)
+    metadata["penumbra:interrupted"] =
+        "after " + std::to_string(result.spp) + " whole passes" +
+        (budget.spp > 0 ? " of " + std::to_string(budget.spp) : std::string());
+  if (reference)
+    for (const std::string& warning : reference->warnings)
+      metadata["penumbra:warnings"] += warning + "\n";
   write_exr(args.output, result.film.color, &result.film.variance, metadata);
   write_png_preview(png_path_for(args.output), result.film.color);
-  std::printf("%s: %s, %s, %u spp, %.3f s compute, %.3f s wall -> %s\n", scene->name.c_str(),
-              args.method.c_str(), args.sampler.c_str(), result.spp, result.compute_seconds,
-              result.wall_seconds, args.output.c_str());
-  if (!args.reference.empty()) {
-    Image reference = read_exr(args.reference);
-    print_errors(error_summary(result.film.color, reference, scene->regions));
+  std::printf("%s: %s, %s, %u spp, %.3f s compute, %.3f s wall -> %s (preview %s)\n",
+              scene->name.c_str(), settings.method.c_str(), settings.sampler.c_str(), result.spp,
+              result.compute_seconds, result.wall_seconds, args.output.c_str(),
+              png_path_for(args.output).c_str());
+  if (result.stopped) {
+    std::printf("render interrupted: the partial image has %u spp (whole passes, unbiased)\n",
+                result.spp);
+    exit_code = 130;
   }
+  if (reference) print_errors(error_summary(result.film.color, reference->image, scene->regions));
 }
 
 std::vector<int> parse_counts(const std::string& text) {
@@ -111,19 +218,35 @@ void add_local_commands(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* render =
       app.add_subcommand("render", "Render a scene locally to an EXR (+ PNG preview)");
-  render->add_option("scene", args->scene, "Scene file (penumbra/scene@1)")->required();
-  render->add_option("--method,-m", args->method, "Method, e.g. sa or bsdf+sa/balance");
-  render->add_option("--sampler,-s", args->sampler, "Sample pattern");
-  render->add_option("--spp", args->spp, "Samples (passes) per pixel")
+  render->add_option("scene", args->scene, "Scene file (penumbra/scene@1 or pbrt-v3)")->required();
+  render->add_option("--method,-m", args->method,
+                     "Method, e.g. sa or bsdf+sa/balance (default: the scene's own, else sa)");
+  render->add_option("--sampler,-s", args->sampler,
+                     "Sample pattern (default: the scene's own, else stratified)");
+  render
+      ->add_option("--spp", args->spp,
+                   "Samples (passes) per pixel (default: the scene's, else 16); with --seconds, "
+                   "the most it renders")
       ->check(CLI::Range(1u, 1u << 20));
-  render->add_option("--seconds", args->seconds, "Render progressively for this much compute time")
-      ->check(CLI::PositiveNumber);
-  render->add_option("--seed", args->seed, "Seed");
+  render
+      ->add_option("--seconds", args->seconds,
+                   "Render progressively for this much compute time (seconds)")
+      ->check(CLI::Range(1e-3, 1e7));
+  render->add_option("--seed", args->seed, "Seed")->check(seed_check())->capture_default_str();
   render->add_option("--threads", args->threads, "Threads (0: all cores)")
       ->check(CLI::Range(0, 1024));
   render->add_option("--tile", args->tile, "Tile size")->check(CLI::Range(1, 4096));
-  render->add_option("-o,--output", args->output, "Output EXR");
-  render->add_option("--reference", args->reference, "Reference EXR: print MRSE, per region too");
+  render
+      ->add_option("-o,--output", args->output,
+                   "Output EXR; its PNG preview goes beside it (FILE.png)")
+      ->capture_default_str();
+  render->add_option("--reference", args->reference,
+                     "Reference EXR of the same scene and resolution: print MRSE, per region too");
+  render->add_flag("--accept-reference-mismatch", args->accept_reference_mismatch,
+                   "Use a reference of another scene (scene_hash differs): warn and record it");
+  render->add_flag("--strict", args->strict,
+                   "Refuse the scene when its reader warns (unknown keys, ignored parameters)");
+  render->add_flag("--quiet,-q", args->quiet, "No progress (a bar on a terminal, else lines)");
   render->callback([args] { run_render(*args); });
 
   // probe
@@ -131,20 +254,26 @@ void add_local_commands(CLI::App& app) {
     std::string scene, probe, method = "sa", sampler = "stratified", samples = "1,2,4,8,16", output;
     int trials = 64;
     uint64_t seed = 0;
+    bool strict = false;
   };
   auto pargs = std::make_shared<ProbeArgs>();
   CLI::App* probe = app.add_subcommand("probe", "Estimator statistics at fixed shading points");
   probe->add_option("scene", pargs->scene, "Scene file")->required();
   probe->add_option("probe", pargs->probe, "Probe file (penumbra/probe@1)")->required();
-  probe->add_option("--method,-m", pargs->method, "Method");
-  probe->add_option("--sampler,-s", pargs->sampler, "Sample pattern");
-  probe->add_option("--samples", pargs->samples, "Sample counts N, comma-separated");
+  probe->add_option("--method,-m", pargs->method, "Method")->capture_default_str();
+  probe->add_option("--sampler,-s", pargs->sampler, "Sample pattern")->capture_default_str();
+  probe->add_option("--samples", pargs->samples, "Sample counts N, comma-separated")
+      ->capture_default_str();
   probe->add_option("--trials", pargs->trials, "Independent estimates per N")
-      ->check(CLI::Range(2, 1 << 24));
-  probe->add_option("--seed", pargs->seed, "Seed");
+      ->check(CLI::Range(2, 1 << 24))
+      ->capture_default_str();
+  probe->add_option("--seed", pargs->seed, "Seed")->check(seed_check())->capture_default_str();
   probe->add_option("--json", pargs->output, "Output file (default: standard output)");
+  probe->add_flag("--strict", pargs->strict, "Refuse the scene when its reader warns");
   probe->callback([pargs] {
+    if (!pargs->output.empty()) check_output_path(pargs->output, {}, "--json");
     auto scene = std::make_shared<const Scene>(load_scene(pargs->scene));
+    report_scene_warnings(*scene, pargs->strict, pargs->scene);
     ProbeSpec spec = parse_probe(read_file(pargs->probe), pargs->probe);
     std::vector<int> counts = parse_counts(pargs->samples);
     ProbeResult result = run_probe(scene, spec, pargs->method, sampler_from(pargs->sampler), counts,
@@ -162,15 +291,16 @@ void add_local_commands(CLI::App& app) {
   // demo
   struct DemoArgs {
     std::string output = "demo-out";
-    double seconds = 4;
+    double seconds = 0;  // 0: the batch's budget
     int threads = 0;
   };
   auto dargs = std::make_shared<DemoArgs>();
   CLI::App* demo = app.add_subcommand(
       "demo", "Render the bundled comparison on cornell-occluders at equal time, with a report");
   demo->add_option("-o,--output", dargs->output, "Output folder");
-  demo->add_option("--seconds", dargs->seconds, "Compute seconds per method")
-      ->check(CLI::PositiveNumber);
+  demo->add_option("--seconds", dargs->seconds,
+                   "Compute seconds per method and repeat (default: the batch's)")
+      ->check(CLI::Range(0.0, 1e7));
   demo->add_option("--threads", dargs->threads, "Threads (0: all cores)");
   demo->callback([dargs] { run_local_demo(dargs->output, dargs->seconds, dargs->threads); });
   add_reproduce_command(app);

@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(penumbra::kVersion));
   app.require_subcommand(1);
   penumbra::add_local_commands(app);
+  penumbra::add_exact_commands(app);
+  penumbra::add_verify_command(app);
 #ifdef PENUMBRA_WITH_FARM
   penumbra::add_farm_commands(app);
   penumbra::add_batch_commands(app);

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Writes the seed corpus of fuzz_task_decoding (fuzz/corpus/task_decoding/): tasks encoded with
 `protoc --encode=penumbra.v1.Task` and result tiles in TileAccumulator's serialized layout
-(core/render/tile.cpp), framed as task_decoding_fuzz.cpp reads them. Run from the repository root."""
+(core/render/tile.cpp), framed as task_decoding_fuzz.cpp reads them; and scene manifests
+(`protoc --encode=penumbra.v1.SceneManifest`) with a chunk (flag bit 1). Run from the repository root."""
+import hashlib
 import os
 import struct
 import subprocess
@@ -11,11 +13,17 @@ OUT = os.path.join(ROOT, "fuzz", "corpus", "task_decoding")
 HASH = "0123456789abcdef" * 4
 
 
-def encode_task(text):
+def encode_task(text, message="penumbra.v1.Task"):
     return subprocess.run(
         ["protoc", "--proto_path=" + os.path.join(ROOT, "proto"),
-         "--encode=penumbra.v1.Task", "penumbra/v1/farm.proto"],
+         "--encode=" + message, "penumbra/v1/farm.proto"],
         input=text.encode(), capture_output=True, check=True).stdout
+
+
+def encode_manifest(total, chunk_bytes, hashes, scene_hash=HASH):
+    text = 'scene_hash: "%s" total_bytes: %d chunk_bytes: %d ' % (scene_hash, total, chunk_bytes)
+    text += " ".join('chunk_hashes: "%s"' % h for h in hashes)
+    return encode_task(text, "penumbra.v1.SceneManifest")
 
 
 def tile_bytes(x0, y0, x1, y1, passes, value=0.5):
@@ -57,3 +65,14 @@ write("unknown-sampler", 1, encode_task(task_text(sampler="lava-lamp")))
 write("hash-escaping", 0, encode_task(task_text(scene_hash="../../etc/passwd")))
 write("hash-of-another-scene", 0, encode_task(task_text()))
 write("empty-task", 0, b"")
+
+# Scene manifests and chunks (flag 2; with 4: the first chunk hash is the chunk's own SHA-256).
+chunk = bytes(range(256)) * 20  # 5120 bytes
+chunk_hash = hashlib.sha256(chunk).hexdigest()
+write("manifest-one-chunk", 2, encode_manifest(len(chunk), 8192, [chunk_hash]), chunk)
+write("manifest-two-chunks", 6, encode_manifest(4096 + 5120, 4096, [HASH, HASH]), chunk[:4096])
+write("manifest-last-chunk-short", 6, encode_manifest(9000, 4096, [HASH, HASH, HASH]), chunk[:4096])
+write("manifest-too-few-hashes", 2, encode_manifest(9000, 4096, [HASH]), chunk)
+write("manifest-chunk-too-small", 2, encode_manifest(100, 16, [HASH]), chunk[:100])
+write("manifest-bad-scene-hash", 2, encode_manifest(100, 4096, [HASH], scene_hash="../x"))
+write("manifest-over-limit", 2, encode_manifest(1 << 40, 1 << 21, [HASH]))

@@ -1,5 +1,6 @@
-// libFuzzer target: what a worker decodes off the wire before rendering (worker/task_decoding.h)
-// and the result tile the coordinator decodes (TileAccumulator::deserialize).
+// libFuzzer target: what a worker decodes off the wire before rendering (worker/task_decoding.h),
+// the result tile the coordinator decodes (TileAccumulator::deserialize), and the scene manifests
+// and chunks both check (proto/support/scene_chunks.h).
 //
 // Input layout: 1 flag byte, a 2-byte little-endian length n, n bytes of a serialized
 // penumbra.v1.Task, then the bytes of a serialized tile. Flag bit 0 replaces the task's scene
@@ -7,6 +8,12 @@
 // SHA-256 preimage. Invariants: a decoded task's tile lies inside the image with a non-empty
 // pass range; a tile that deserializes serializes back to the same bytes; a fresh tile of a
 // decoded rect round-trips.
+//
+// Flag bit 1: the n bytes are a serialized penumbra.v1.SceneManifest and the rest a chunk of it;
+// bit 2 replaces the manifest's first chunk hash by the chunk's SHA-256 (again: no preimage
+// needed). Invariants: a manifest that passes the checks has chunks of positive size, at most
+// chunk_bytes, summing to total_bytes; a chunk that passes has the listed size and hash; the
+// checks throw SceneChunkError naming the field and nothing else.
 
 #include <google/protobuf/stubs/logging.h>
 
@@ -18,6 +25,7 @@
 
 #include "core/scene/scene_package.h"
 #include "fuzz/fuzz_check.h"
+#include "proto/support/scene_chunks.h"
 #include "worker/task_decoding.h"
 
 namespace {
@@ -74,6 +82,50 @@ void check_tile_bytes(std::string_view bytes, const penumbra::farm::DecodedTask*
   for (int64_t i = 0; i < film.rect().pixel_count(); ++i) FUZZ_CHECK(is_finite(film.mean(i)));
 }
 
+void check_manifest_bytes(std::string_view manifest_bytes, std::string_view chunk,
+                          bool fix_first_hash) {
+  using namespace penumbra::farm;
+  penumbra::v1::SceneManifest manifest;
+  if (!manifest.ParseFromArray(manifest_bytes.data(), int(manifest_bytes.size()))) return;
+  if (fix_first_hash && manifest.chunk_hashes_size() > 0)
+    manifest.set_chunk_hashes(0, penumbra::sha256_hex(chunk));
+  const uint64_t limit = uint64_t(64) << 20;
+  try {
+    check_scene_manifest(manifest, limit);
+  } catch (const SceneChunkError& error) {
+    FUZZ_CHECK(std::string_view(error.what()).rfind("manifest.", 0) == 0);
+    return;
+  }
+  FUZZ_CHECK(manifest.total_bytes() > 0 && manifest.total_bytes() <= limit);
+  uint64_t total = 0;
+  for (uint32_t i = 0; i < uint32_t(manifest.chunk_hashes_size()); ++i) {
+    const uint32_t size = scene_chunk_size(manifest, i);
+    FUZZ_CHECK(size > 0 && size <= manifest.chunk_bytes());
+    total += size;
+  }
+  FUZZ_CHECK(total == manifest.total_bytes());
+  for (uint32_t index :
+       {0u, uint32_t(manifest.chunk_hashes_size() - 1), uint32_t(manifest.chunk_hashes_size())}) {
+    try {
+      check_scene_chunk(manifest, index, chunk);
+    } catch (const SceneChunkError& error) {
+      FUZZ_CHECK(std::string_view(error.what()).rfind("chunk", 0) == 0);
+      continue;
+    }
+    FUZZ_CHECK(chunk.size() == scene_chunk_size(manifest, index));
+    FUZZ_CHECK(penumbra::sha256_hex(chunk) == manifest.chunk_hashes(int(index)));
+  }
+  // A one-chunk manifest of exactly this chunk assembles to it.
+  if (manifest.chunk_hashes_size() == 1) {
+    try {
+      std::string whole =
+          assemble_scene_chunks(manifest, [&](uint32_t) { return std::string(chunk); });
+      FUZZ_CHECK(whole == chunk);
+    } catch (const SceneChunkError&) {
+    }
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -88,6 +140,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string_view tile_bytes(reinterpret_cast<const char*>(data) + 3 + task_size,
                               size - 3 - task_size);
 
+  if (data[0] & 2) {
+    check_manifest_bytes(task_bytes, tile_bytes, data[0] & 4);
+    return 0;
+  }
   const Scene& scene = fixed_scene();
   v1::Task task;
   if (!task.ParseFromArray(task_bytes.data(), int(task_bytes.size()))) {

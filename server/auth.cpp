@@ -39,6 +39,7 @@ std::optional<Role> parse_role(std::string_view text) {
   if (text == "client") return Role::client;
   if (text == "worker") return Role::worker;
   if (text == "admin") return Role::admin;
+  if (text == "viewer") return Role::viewer;
   return std::nullopt;
 }
 
@@ -130,6 +131,8 @@ std::string role_name(Role role) {
       return "worker";
     case Role::admin:
       return "admin";
+    case Role::viewer:
+      return "viewer";
   }
   return "unknown";
 }
@@ -152,7 +155,7 @@ TokenTable TokenTable::parse(std::string_view text, std::string_view source_name
     std::optional<Role> role = parse_role(role_text);
     if (!role)
       throw std::runtime_error(where() + "unknown role \"" + role_text +
-                               "\" (client, worker or admin)");
+                               "\" (client, worker, admin or viewer)");
     if (token.size() < kMinTokenLength)
       throw std::runtime_error(where() + "the token of " + name + " is shorter than " +
                                std::to_string(kMinTokenLength) + " characters");
@@ -261,6 +264,59 @@ std::optional<CallAuthorization> call_authorization(const grpc::ServerContextBas
   auto found = registry().calls.find(context);
   if (found == registry().calls.end()) return std::nullopt;
   return found->second;
+}
+
+CallContext call_context_of(const grpc::ServerContextBase* context) {
+  std::optional<CallAuthorization> authorization = call_authorization(context);
+  if (!authorization || !authorization->principal) return CallContext::internal();
+  const Principal& principal = *authorization->principal;
+  return principal.role == Role::admin ? CallContext::of_admin(principal.name)
+                                       : CallContext::of_client(principal.name);
+}
+
+HttpAuthorization authorize_http(const TokenTable* tokens,
+                                 std::optional<std::string_view> authorization_header,
+                                 std::optional<std::string_view> token_parameter) {
+  HttpAuthorization result;
+  if (!tokens) return result;  // authentication off
+  auto refuse = [&](int status, std::string message) {
+    result.status = status;
+    result.message = std::move(message);
+    result.caller = CallContext::of_client(std::string());
+    result.sees_farm = false;
+    return result;
+  };
+  std::optional<std::string_view> token;
+  if (authorization_header) {
+    token = bearer_token(*authorization_header);
+    if (!token) return refuse(401, "the Authorization header is not \"Bearer <token>\"");
+  } else if (token_parameter) {
+    token = *token_parameter;
+    result.token_from_query = true;
+  }
+  if (!token)
+    return refuse(401,
+                  "this coordinator requires a token: send \"Authorization: Bearer <token>\", or "
+                  "add ?token=<token> to the address in a browser");
+  result.principal = tokens->find(*token);
+  if (!result.principal) return refuse(401, "unknown token");
+  const Principal& who = *result.principal;
+  switch (who.role) {
+    case Role::worker:
+      return refuse(403, "\"" + who.name +
+                             "\" has role worker, which has no access to the web side (client, "
+                             "viewer or admin)");
+    case Role::client:
+      result.caller = CallContext::of_client(who.name);
+      result.sees_farm = false;
+      break;
+    case Role::viewer:
+    case Role::admin:
+      result.caller = CallContext::of_admin(who.name);
+      result.sees_farm = true;
+      break;
+  }
+  return result;
 }
 
 grpc::experimental::Interceptor* AuthInterceptorFactory::CreateServerInterceptor(

@@ -2,10 +2,11 @@
 // Token authentication with roles for the coordinator's gRPC API.
 //
 // A caller presents "authorization: Bearer <token>" metadata. Tokens come from a file of lines
-// "role name token" (role: client, worker or admin; '#' starts a comment). The roles:
+// "role name token" (role: client, worker, admin or viewer; '#' starts a comment). The roles:
 //   client — every method of /penumbra.v1.Jobs/ and /penumbra.v1.Batches/;
 //   worker — every method of /penumbra.v1.Workers/;
-//   admin  — both.
+//   admin  — both;
+//   viewer — no gRPC method: the web side only (authorize_http), where it reads everything.
 // Health checking (/grpc.health.v1.Health/) and server reflection stay open; any other method
 // needs admin. No token or an unknown one: UNAUTHENTICATED; a known token of the wrong role:
 // PERMISSION_DENIED. Tokens are compared in constant time (SHA-256 digests compared with
@@ -32,9 +33,11 @@
 #include <string_view>
 #include <vector>
 
+#include "server/call_context.h"
+
 namespace penumbra::farm {
 
-enum class Role { client, worker, admin };
+enum class Role { client, worker, admin, viewer };
 
 std::string role_name(Role role);
 
@@ -92,6 +95,32 @@ CallAuthorization authorize_call(const AuthPolicy& policy, std::string_view meth
 // The decision the interceptor made for the call of `context`; nullopt when the server has no
 // auth interceptor (authentication off). Valid from before the handler runs until the call ends.
 std::optional<CallAuthorization> call_authorization(const grpc::ServerContextBase* context);
+
+// The caller of `context` for the coordinator (server/call_context.h): an authenticated client
+// sees its own jobs, an admin every job; without a known principal (authentication off) the
+// call sees every job.
+CallContext call_context_of(const grpc::ServerContextBase* context);
+
+// The web side (server/http_frontend.h). A request presents its token in an
+// "Authorization: Bearer <token>" header or, for a browser that follows links and loads images,
+// in a "token" query parameter (the header wins when both are given). With authentication on:
+//   no token, a malformed header or an unknown token: 401;
+//   a worker token: 403 (workers have nothing to read there);
+//   a client token: 200, seeing its own jobs and batches only (another's are 404 like an unknown
+//     id), and not the farm-wide pages (/metrics): 403;
+//   a viewer or admin token: 200, seeing everything.
+// With authentication off (no tokens) every request sees everything.
+struct HttpAuthorization {
+  int status = 200;     // 200, 401 or 403
+  std::string message;  // why not (never the token)
+  std::optional<Principal> principal;
+  CallContext caller = CallContext::internal();  // whose jobs and batches it sees
+  bool sees_farm = true;                         // viewer, admin or authentication off
+  bool token_from_query = false;                 // the token came in the "token" parameter
+};
+HttpAuthorization authorize_http(const TokenTable* tokens,
+                                 std::optional<std::string_view> authorization_header,
+                                 std::optional<std::string_view> token_parameter);
 
 class AuthInterceptorFactory final : public grpc::experimental::ServerInterceptorFactoryInterface {
  public:

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "core/image/image.h"
-#include "core/method/direct_lighting.h"
 #include "core/method/method.h"
+#include "core/method/method_check.h"
 #include "core/scene/json_node.h"
 
 namespace penumbra::farm {
@@ -37,6 +37,8 @@ std::string reference_kind_name(BatchReferenceKind kind) {
       return "exr";
     case BatchReferenceKind::Job:
       return "job";
+    case BatchReferenceKind::Exact:
+      return "exact";
   }
   return "auto";
 }
@@ -105,19 +107,35 @@ BatchManager::~BatchManager() {
 }
 
 v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& request,
-                                             const std::string& owner) {
+                                             const CallContext& caller) {
+  const std::string& owner = caller.client;
   std::string source = request.source_name().empty() ? "batch spec" : request.source_name();
   BatchSpec spec = parse_batch_spec(request.spec_json(), source, options_.limits);
-  if (!request.has_scene())
-    throw invalid(
-        "scene: the request carries no scene package (the client packs the spec's "
-        "scene \"" +
-        spec.scene + "\")");
+  // The scene: a package in the request, or one uploaded in chunks and named by its hash.
+  v1::ScenePackage uploaded;
+  if (!request.has_scene()) {
+    if (request.scene_hash().empty())
+      throw invalid(
+          "scene: the request carries no scene package and no scene_hash (the client packs "
+          "or uploads the spec's scene \"" +
+          spec.scene + "\")");
+    uploaded = coordinator_.scene(request.scene_hash());
+  }
+  const v1::ScenePackage& package = request.has_scene() ? request.scene() : uploaded;
   Scene scene;
   try {
-    scene = parser_(request.scene());
+    scene = parser_(package);
   } catch (const FormatError& error) {
     throw invalid(std::string("scene: ") + error.what());
+  }
+  if (!request.has_scene() && scene.content_hash != request.scene_hash())
+    throw invalid("scene_hash: the stored scene " + request.scene_hash().substr(0, 12) +
+                  " parses to another content hash " + scene.content_hash.substr(0, 12));
+  if (spec.strict && !scene.warnings.empty()) {
+    std::string list;
+    for (const std::string& warning : scene.warnings) list += "; " + warning;
+    throw invalid("$.strict: the scene has " + std::to_string(scene.warnings.size()) +
+                  " warning(s) (in " + source + ")" + list);
   }
 
   // Regions: the scene's, then the spec's (which must lie inside the image).
@@ -146,30 +164,42 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
   v1::BatchReferenceStatus& reference = *status.mutable_reference();
   reference.set_kind(reference_kind_name(spec.reference.kind));
   switch (spec.reference.kind) {
+    case BatchReferenceKind::Exact:  // rendered and uploaded by the client, like an EXR
     case BatchReferenceKind::Exr: {
       if (request.reference_exr().empty())
         throw invalid("$.reference: the spec names the EXR \"" + spec.reference.exr_path +
                       "\" but the request carries no reference_exr (in " + source + ")");
       Image image;
+      ImageMetadata reference_metadata;
       try {
-        image = decode_exr(request.reference_exr());
+        image = decode_exr(request.reference_exr(), &reference_metadata);
       } catch (const std::exception& error) {
         throw invalid("$.reference: \"" + spec.reference.exr_path +
                       "\" is not a readable EXR: " + error.what());
       }
+      const std::string reference_hash = reference_metadata["penumbra:scene_hash"];
       if (image.width != scene.camera.width || image.height != scene.camera.height)
         throw invalid("$.reference: \"" + spec.reference.exr_path + "\" is " +
                       std::to_string(image.width) + "x" + std::to_string(image.height) +
                       ", the scene is " + std::to_string(scene.camera.width) + "x" +
                       std::to_string(scene.camera.height));
+      // A reference of another scene would measure the difference of the scenes.
+      if (!reference_hash.empty() && reference_hash != scene.content_hash)
+        throw invalid("$.reference: \"" + spec.reference.exr_path +
+                      "\" is of another scene (scene_hash " + reference_hash.substr(0, 12) +
+                      ", the spec's scene " + scene.content_hash.substr(0, 12) + ")");
       stored.set_reference_exr(request.reference_exr());
       reference.set_state(v1::JOB_STATE_DONE);
+      if (spec.reference.kind == BatchReferenceKind::Exact) {
+        reference.set_method("exact (fallback " + spec.reference.fallback_method + ")");
+        reference.set_spp(spec.reference.camera_samples);
+      }
       break;
     }
     case BatchReferenceKind::Job: {
       v1::JobStatus job;
       try {
-        job = coordinator_.status(spec.reference.job_id, false);
+        job = coordinator_.status(caller, spec.reference.job_id, false);
       } catch (const FarmError& error) {
         throw FarmError(error.code(), std::string("$.reference: ") + error.what());
       }
@@ -179,6 +209,10 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
                       std::to_string(job.height()) + ", the scene is " +
                       std::to_string(scene.camera.width) + "x" +
                       std::to_string(scene.camera.height));
+      if (job.scene_hash() != scene.content_hash)
+        throw invalid("$.reference: " + job.job_id() + " rendered another scene (" +
+                      job.scene_name() + ", scene_hash " + job.scene_hash().substr(0, 12) +
+                      "; the spec's scene " + scene.content_hash.substr(0, 12) + ")");
       if (job.state() == v1::JOB_STATE_FAILED || job.state() == v1::JOB_STATE_CANCELLED)
         throw invalid("$.reference: " + job.job_id() + " ended " + v1::JobState_Name(job.state()) +
                       "; it has no image");
@@ -221,7 +255,7 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
     }
     // What the estimator cannot run on this scene never reaches a worker.
     try {
-      DirectLighting check(scene, parse_method(method.method));
+      check_method_runs_on(scene, parse_method(method.method));
     } catch (const FormatError& error) {
       entry->set_error(error.what());
     }
@@ -230,7 +264,7 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
   status.set_owner(owner);
   stored.set_source_name(source);
 
-  coordinator_.store_scene(scene.content_hash, request.scene());
+  if (request.has_scene()) coordinator_.store_scene(scene.content_hash, request.scene());
 
   v1::SubmitBatchResponse response;
   {
@@ -263,30 +297,33 @@ std::string BatchManager::json_region_path(const std::string& name) {
   return json_member_path("$.regions", name);
 }
 
-BatchManager::Batch& BatchManager::batch_locked(const std::string& batch_id) {
+BatchManager::Batch& BatchManager::batch_locked(const std::string& batch_id,
+                                                const CallContext& caller) {
   uint64_t number = parse_batch_number(batch_id);
   auto it = batches_.find(number);
-  if (number == 0 || it == batches_.end())
+  if (number == 0 || it == batches_.end() || !caller.may_see(it->second->stored.status().owner()))
     throw FarmError(FarmErrorCode::NotFound,
                     "no batch \"" + batch_id + "\" (batch ids look like batch-3)");
   return *it->second;
 }
 
-v1::BatchStatus BatchManager::status(const std::string& batch_id, bool with_curves) {
+v1::BatchStatus BatchManager::status(const std::string& batch_id, bool with_curves,
+                                     const CallContext& caller) {
   std::lock_guard lock(mutex_);
-  return status_locked(batch_locked(batch_id), with_curves);
+  return status_locked(batch_locked(batch_id, caller), with_curves);
 }
 
-std::vector<v1::BatchStatus> BatchManager::list() {
+std::vector<v1::BatchStatus> BatchManager::list(const CallContext& caller) {
   std::lock_guard lock(mutex_);
   std::vector<v1::BatchStatus> out;
-  for (auto& [number, batch] : batches_) out.push_back(status_locked(*batch, false));
+  for (auto& [number, batch] : batches_)
+    if (caller.may_see(batch->stored.status().owner())) out.push_back(status_locked(*batch, false));
   return out;
 }
 
-v1::BatchStatus BatchManager::cancel(const std::string& batch_id) {
+v1::BatchStatus BatchManager::cancel(const std::string& batch_id, const CallContext& caller) {
   std::lock_guard lock(mutex_);
-  Batch& batch = batch_locked(batch_id);
+  Batch& batch = batch_locked(batch_id, caller);
   if (!is_terminal(batch.stored.status().state())) {
     finish(batch, v1::BATCH_STATE_CANCELLED);
     changed_locked();
@@ -294,11 +331,11 @@ v1::BatchStatus BatchManager::cancel(const std::string& batch_id) {
   return status_locked(batch, false);
 }
 
-std::string BatchManager::reference_exr(const std::string& batch_id) {
+std::string BatchManager::reference_exr(const std::string& batch_id, const CallContext& caller) {
   std::string job_id;
   {
     std::lock_guard lock(mutex_);
-    Batch& batch = batch_locked(batch_id);
+    Batch& batch = batch_locked(batch_id, caller);
     if (!batch.stored.reference_exr().empty()) return batch.stored.reference_exr();
     job_id = batch.stored.status().reference().job_id();
   }
@@ -457,7 +494,7 @@ bool BatchManager::advance_reference(Batch& batch) {
     }
     changed = true;
   }
-  if (reference.kind() != "exr") {
+  if (reference.kind() != "exr" && reference.kind() != "exact") {
     v1::JobStatus job = coordinator_.status(reference.job_id(), false);
     if (reference.state() != job.state()) {
       reference.set_state(job.state());

@@ -72,17 +72,24 @@ class BatchManager {
   BatchManager(const BatchManager&) = delete;
   BatchManager& operator=(const BatchManager&) = delete;
 
+  // Every call acts for `caller` (server/call_context.h): a batch is owned by the client that
+  // submitted it, and another owner's batch is NOT_FOUND like an unknown id.
   // Validates the spec against the scene (FormatError / FarmError InvalidArgument naming the
-  // field; NotFound for an unknown reference job), stores the batch and starts it.
-  v1::SubmitBatchResponse submit(const v1::SubmitBatchRequest& request, const std::string& owner);
+  // field; NotFound for an unknown reference job or one the caller may not see), stores the
+  // batch and starts it.
+  v1::SubmitBatchResponse submit(const v1::SubmitBatchRequest& request,
+                                 const CallContext& caller = CallContext::internal());
   // NotFound for an unknown id. `with_curves`: the runs' jobs with their MRSE curves.
-  v1::BatchStatus status(const std::string& batch_id, bool with_curves = true);
-  std::vector<v1::BatchStatus> list();
+  v1::BatchStatus status(const std::string& batch_id, bool with_curves = true,
+                         const CallContext& caller = CallContext::internal());
+  std::vector<v1::BatchStatus> list(const CallContext& caller = CallContext::internal());
   // Cancels the batch's unfinished jobs (never a shared auto reference).
-  v1::BatchStatus cancel(const std::string& batch_id);
+  v1::BatchStatus cancel(const std::string& batch_id,
+                         const CallContext& caller = CallContext::internal());
   // The reference EXR (the reference job's result or the uploaded file); FailedPrecondition
   // while it is not rendered yet.
-  std::string reference_exr(const std::string& batch_id);
+  std::string reference_exr(const std::string& batch_id,
+                            const CallContext& caller = CallContext::internal());
 
   // A counter that grows whenever some batch may have changed; wait_for_change blocks until it
   // differs from `seen` or `timeout` passes, and returns its value.
@@ -98,7 +105,8 @@ class BatchManager {
   };
 
   static std::string json_region_path(const std::string& name);
-  Batch& batch_locked(const std::string& batch_id);
+  Batch& batch_locked(const std::string& batch_id,
+                      const CallContext& caller = CallContext::internal());
   void drive_loop();
   // Moves the batch on as far as its jobs allow; true when it changed (and was saved).
   bool advance(Batch& batch);

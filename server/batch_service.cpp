@@ -16,11 +16,6 @@ std::optional<grpc::Status> refusal(const grpc::ServerContext* context) {
   return std::nullopt;
 }
 
-std::string caller(const grpc::ServerContext* context) {
-  std::optional<CallAuthorization> authorization = call_authorization(context);
-  return authorization && authorization->principal ? authorization->principal->name : std::string();
-}
-
 template <typename Body>
 grpc::Status guarded(const grpc::ServerContext* context, Body&& body) {
   if (std::optional<grpc::Status> refused = refusal(context)) return *refused;
@@ -32,23 +27,26 @@ grpc::Status guarded(const grpc::ServerContext* context, Body&& body) {
 grpc::Status BatchesService::SubmitBatch(grpc::ServerContext* context,
                                          const v1::SubmitBatchRequest* request,
                                          v1::SubmitBatchResponse* response) {
-  return guarded(context, [&] { *response = manager_.submit(*request, caller(context)); });
+  return guarded(context, [&] { *response = manager_.submit(*request, call_context_of(context)); });
 }
 
 grpc::Status BatchesService::GetBatch(grpc::ServerContext* context,
                                       const v1::GetBatchRequest* request,
                                       v1::BatchStatus* response) {
-  return guarded(context, [&] { *response = manager_.status(request->batch_id(), true); });
+  return guarded(context, [&] {
+    *response = manager_.status(request->batch_id(), true, call_context_of(context));
+  });
 }
 
 grpc::Status BatchesService::WatchBatch(grpc::ServerContext* context,
                                         const v1::WatchBatchRequest* request,
                                         grpc::ServerWriter<v1::BatchStatus>* writer) {
   return guarded(context, [&] {
+    const CallContext caller = call_context_of(context);
     std::string last;
     uint64_t seen = manager_.version();
     while (!context->IsCancelled()) {
-      v1::BatchStatus status = manager_.status(request->batch_id(), false);
+      v1::BatchStatus status = manager_.status(request->batch_id(), false, caller);
       // wall_seconds changes all the time: compare without it.
       v1::BatchStatus compared = status;
       compared.clear_wall_seconds();
@@ -68,21 +66,23 @@ grpc::Status BatchesService::ListBatches(grpc::ServerContext* context,
                                          const v1::ListBatchesRequest*,
                                          v1::ListBatchesResponse* response) {
   return guarded(context, [&] {
-    for (v1::BatchStatus& status : manager_.list()) *response->add_batches() = std::move(status);
+    for (v1::BatchStatus& status : manager_.list(call_context_of(context)))
+      *response->add_batches() = std::move(status);
   });
 }
 
 grpc::Status BatchesService::CancelBatch(grpc::ServerContext* context,
                                          const v1::CancelBatchRequest* request,
                                          v1::BatchStatus* response) {
-  return guarded(context, [&] { *response = manager_.cancel(request->batch_id()); });
+  return guarded(
+      context, [&] { *response = manager_.cancel(request->batch_id(), call_context_of(context)); });
 }
 
 grpc::Status BatchesService::FetchBatchReference(grpc::ServerContext* context,
                                                  const v1::FetchBatchReferenceRequest* request,
                                                  grpc::ServerWriter<v1::ResultChunk>* writer) {
   return guarded(context, [&] {
-    std::string exr = manager_.reference_exr(request->batch_id());
+    std::string exr = manager_.reference_exr(request->batch_id(), call_context_of(context));
     constexpr size_t kChunkBytes = size_t(1) << 20;
     for (size_t offset = 0; offset < exr.size(); offset += kChunkBytes) {
       v1::ResultChunk chunk;

@@ -1,5 +1,6 @@
 #include "server/coordinator.h"
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -9,8 +10,8 @@
 #include <tuple>
 
 #include "core/image/metrics.h"
-#include "core/method/direct_lighting.h"
 #include "core/method/method.h"
+#include "core/method/method_check.h"
 #include "core/render/renderer.h"
 #include "core/sampling/pattern.h"
 #include "penumbra/version.h"
@@ -104,6 +105,7 @@ Coordinator::Coordinator(CoordinatorOptions options, SceneParser parser)
     : options_(std::move(options)),
       parser_(std::move(parser)),
       store_(options_.data_dir),
+      transfer_(store_, parser_, options_.max_scene_bytes),
       leases_(options_.lease_time, std::random_device{}()) {
   if (options_.build_flavour.empty()) options_.build_flavour = kBuildFlavour;
   for (const JobRecord& record : store_.jobs()) resume(record);
@@ -119,8 +121,19 @@ Coordinator::~Coordinator() {
   expiry_thread_.join();
 }
 
+std::chrono::milliseconds Coordinator::heartbeat_period() const {
+  return std::max(std::chrono::milliseconds(1),
+                  std::min(options_.heartbeat_interval, options_.lease_time / 3));
+}
+
+std::chrono::milliseconds Coordinator::dead_after() const {
+  const auto period = heartbeat_period();
+  return period * std::max<uint32_t>(options_.missed_heartbeats, 1) + period / 2;
+}
+
 void Coordinator::expiry_loop() {
-  auto period = std::max(std::chrono::milliseconds(10), options_.lease_time / 4);
+  auto period = std::max(std::chrono::milliseconds(10),
+                         std::min(options_.lease_time, heartbeat_period()) / 4);
   std::unique_lock lock(expiry_mutex_);
   while (!expiry_wake_.wait_for(lock, period, [this] { return stopping_; })) {
     lock.unlock();
@@ -220,6 +233,14 @@ v1::SubmitJobResponse Coordinator::submit(const v1::JobSpec& request) {
   return submit_spec(std::move(spec));
 }
 
+v1::SubmitJobResponse Coordinator::submit(const CallContext& caller, const v1::JobSpec& request) {
+  v1::JobSpec spec = request;
+  spec.clear_batch_id();
+  // The owner is whoever called, never what the request says.
+  spec.set_owner(caller.client);
+  return submit_spec(std::move(spec), false, caller);
+}
+
 v1::SubmitJobResponse Coordinator::submit_in_batch(const v1::JobSpec& request,
                                                    const std::string& batch_id,
                                                    bool awaits_pass_count) {
@@ -234,7 +255,8 @@ void Coordinator::store_scene(const std::string& scene_hash, const v1::ScenePack
   store_.put_scene(scene_hash, package.SerializeAsString());
 }
 
-v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pass_count) {
+v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pass_count,
+                                               const CallContext& caller) {
   // Validation and scene parsing happen outside the lock: they can take a while.
   if (spec.method().empty()) throw invalid("spec.method: empty; give a method such as \"sa\"");
   try {
@@ -281,8 +303,10 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
     for (const auto& [path, data] : package.files()) bytes += path.size() + data.size();
     if (bytes > options_.max_scene_bytes)
       throw FarmError(FarmErrorCode::ResourceExhausted,
-                      "spec.scene: " + std::to_string(bytes) + " bytes exceed the limit of " +
-                          std::to_string(options_.max_scene_bytes));
+                      "spec.scene: " + std::to_string(bytes) +
+                          " bytes exceed the coordinator's scene-size limit of " +
+                          std::to_string(options_.max_scene_bytes) +
+                          " bytes (penumbra-coordinator --max-scene-mib)");
   } else if (!spec.scene_hash().empty()) {
     auto stored = store_.scene(spec.scene_hash());
     if (!stored)
@@ -301,18 +325,41 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
   if (!spec.scene_hash().empty() && spec.scene_hash() != scene->content_hash)
     throw invalid("spec.scene_hash: " + spec.scene_hash() + " does not match the scene's hash " +
                   scene->content_hash);
+  // What the scene reader ignored travels with the job (status, EXR), or refuses it.
+  std::vector<std::string> warnings = scene->warnings;
+  if (spec.strict() && !warnings.empty()) {
+    std::string list;
+    for (const std::string& warning : warnings) list += "; " + warning;
+    throw invalid("scene: " + std::to_string(warnings.size()) +
+                  " warning(s) refused by spec.strict" + list);
+  }
+  // A reference of another scene (its scene hash differs) measures the difference of the
+  // scenes, not the method's error: refused unless the client accepts it, then recorded.
+  auto check_reference_scene = [&](const std::string& field, const std::string& hash,
+                                   const std::string& name) {
+    if (hash.empty() || hash == scene->content_hash) return;
+    const std::string what = field + ": the reference" + (name.empty() ? "" : " " + name) +
+                             " is of another scene (scene_hash " + hash.substr(0, 12) +
+                             ", this job's " + scene->content_hash.substr(0, 12) + ")";
+    if (!spec.accept_reference_mismatch())
+      throw invalid(what +
+                    "; set accept_reference_mismatch (--accept-reference-mismatch) to "
+                    "use it anyway");
+    warnings.push_back(what + "; accepted (accept_reference_mismatch)");
+  };
   // The method must be able to run on this scene (line-bd16 refuses GGX, the Peters
   // combinations need psa and ltc, ...): refused now, not after a worker's three failures.
   try {
-    DirectLighting estimator(*scene, parse_method(spec.method()));
+    check_method_runs_on(*scene, parse_method(spec.method()));
   } catch (const FormatError& error) {
     throw invalid(error.what());
   }
 
   std::optional<Image> reference;
   if (spec.reference_case() == v1::JobSpec::kReferenceExr) {
+    ImageMetadata reference_metadata;
     try {
-      reference = decode_exr(spec.reference_exr());
+      reference = decode_exr(spec.reference_exr(), &reference_metadata);
     } catch (const std::exception& error) {
       throw invalid(std::string("spec.reference_exr: not a readable EXR: ") + error.what());
     }
@@ -321,6 +368,8 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
                     std::to_string(reference->height) + " does not match the scene's " +
                     std::to_string(scene->camera.width) + "x" +
                     std::to_string(scene->camera.height));
+    check_reference_scene("spec.reference_exr", reference_metadata["penumbra:scene_hash"],
+                          reference_metadata["penumbra:scene"]);
   }
 
   auto tiles = cut_tiles(scene->camera.width, scene->camera.height, int(tile_size));
@@ -335,13 +384,15 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
     if (spec.reference_case() == v1::JobSpec::kReferenceJob) {
       uint64_t reference_id = parse_job_id(spec.reference_job());
       auto it = jobs_.find(reference_id);
-      if (it == jobs_.end())
+      if (it == jobs_.end() || !caller.may_see(it->second->spec().owner()))
         throw FarmError(FarmErrorCode::NotFound,
                         "spec.reference_job: no job " + spec.reference_job());
       if (it->second->stored.width() != uint32_t(scene->camera.width) ||
           it->second->stored.height() != uint32_t(scene->camera.height))
         throw invalid("spec.reference_job: " + spec.reference_job() +
                       " has another resolution than this scene");
+      check_reference_scene("spec.reference_job", it->second->spec().scene_hash(),
+                            job_name(reference_id));
       spec.set_reference_job(job_name(reference_id));
     }
     auto job = std::make_unique<Job>();
@@ -352,6 +403,7 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
     job->stored.set_tile_size(tile_size);
     job->stored.set_passes_per_task(passes_per_task);
     job->stored.set_awaits_pass_count(awaits_pass_count);
+    for (const std::string& warning : warnings) job->stored.add_warnings(warning);
     job->tiles = std::move(tiles);
     job->tile_count = job->tiles.size();
     job->total_blocks = job->seconds_budget() ? options_.max_spp / passes_per_task
@@ -610,12 +662,14 @@ void Coordinator::set_batch_listener(std::function<void()> listener) {
   batch_listener_ = std::move(listener);
 }
 
-void Coordinator::finish(Job& job) {
-  uint32_t spp =
-      job.record.blocks_sealed == 0
-          ? 0
-          : task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second;
-  Film film = assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+uint32_t Coordinator::sealed_passes(const Job& job) const {
+  return job.record.blocks_sealed == 0
+             ? 0
+             : task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second;
+}
+
+std::string Coordinator::encode_result(const Job& job, const Film& film, uint32_t spp,
+                                       const ImageMetadata& extra) const {
   RenderOptions render_options;
   render_options.method = job.spec().method();
   render_options.sampler = parse_pattern(job.spec().sampler()).value_or(Pattern::Stratified);
@@ -623,30 +677,45 @@ void Coordinator::finish(Job& job) {
   ImageMetadata metadata =
       render_metadata(*job.scene, render_options, spp, job.record.compute_seconds);
   metadata["penumbra:job"] = job_name(job.record.id);
+  // The scene's warnings (render_metadata has them) and an accepted reference mismatch.
+  std::string warnings;
+  for (const std::string& warning : job.stored.warnings()) warnings += warning + "\n";
+  if (!warnings.empty()) metadata["penumbra:warnings"] = warnings;
+  for (const auto& [key, value] : extra) metadata[key] = value;
+  return encode_exr(film.color, &film.variance, metadata);
+}
+
+void Coordinator::record_final_errors(Job& job, const Film& film) {
+  load_reference(job);
+  job.errors.Clear();
+  if (!job.reference) return;
+  try {
+    for (const auto& [region, summary] :
+         error_summary(film.color, *job.reference, job.scene->regions)) {
+      v1::RegionError* error = job.errors.add_errors();
+      error->set_region(region);
+      error->set_mrse(summary.mrse);
+      error->set_mse(summary.mse);
+      error->set_rmse(summary.rmse);
+    }
+    job.record.final_errors = job.errors.SerializeAsString();
+  } catch (const std::exception& error) {
+    job.errors.Clear();
+    spdlog::warn("{}: no final errors: {}", job_name(job.record.id), error.what());
+  }
+}
+
+void Coordinator::finish(Job& job) {
+  const uint32_t spp = sealed_passes(job);
+  Film film = assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
   std::string exr;
   try {
-    exr = encode_exr(film.color, &film.variance, metadata);
+    exr = encode_result(job, film, spp, {});
   } catch (const std::exception& error) {
     end_job(job, v1::JOB_STATE_FAILED, std::string("cannot encode the EXR: ") + error.what());
     return;
   }
-  load_reference(job);
-  job.errors.Clear();
-  if (job.reference) {
-    try {
-      for (const auto& [region, summary] :
-           error_summary(film.color, *job.reference, job.scene->regions)) {
-        v1::RegionError* error = job.errors.add_errors();
-        error->set_region(region);
-        error->set_mrse(summary.mrse);
-        error->set_mse(summary.mse);
-        error->set_rmse(summary.rmse);
-      }
-      job.record.final_errors = job.errors.SerializeAsString();
-    } catch (const std::exception& error) {
-      spdlog::warn("{}: no final errors: {}", job_name(job.record.id), error.what());
-    }
-  }
+  record_final_errors(job, film);
   if (film.nonfinite_samples)
     spdlog::error("{}: {} samples were not finite (counted as zero)", job_name(job.record.id),
                   film.nonfinite_samples);
@@ -693,9 +762,10 @@ uint64_t Coordinator::parse_job_id(const std::string& job_id) const {
   return std::stoull(digits);
 }
 
-Coordinator::Job& Coordinator::job_locked(const std::string& job_id) {
+Coordinator::Job& Coordinator::job_locked(const std::string& job_id, const CallContext& caller) {
   auto it = jobs_.find(parse_job_id(job_id));
-  if (it == jobs_.end()) throw FarmError(FarmErrorCode::NotFound, "no job " + job_id);
+  if (it == jobs_.end() || !caller.may_see(it->second->spec().owner()))
+    throw FarmError(FarmErrorCode::NotFound, "no job " + job_id);
   return *it->second;
 }
 
@@ -745,9 +815,17 @@ v1::JobStatus Coordinator::status_locked(const Job& job, bool with_curve) const 
     for (const auto& [task, tile] : job.pending) ++done_per_tile[task % job.tile_count];
     for (uint32_t done : done_per_tile) tiles_complete += done == open_blocks;
   }
+  uint64_t tasks_complete = uint64_t(record.blocks_sealed) * job.tile_count + job.pending.size();
+  if (record.state == v1::JOB_STATE_CANCELLED) {
+    tiles_complete = std::max(tiles_complete, job.stored.tiles_complete_at_cancel());
+    tasks_complete = std::max(tasks_complete, job.stored.tasks_complete_at_cancel());
+  }
   status.set_tiles_complete(tiles_complete);
   status.set_tasks_total(uint64_t(record.blocks_opened) * job.tile_count);
-  status.set_tasks_complete(uint64_t(record.blocks_sealed) * job.tile_count + job.pending.size());
+  status.set_tasks_complete(tasks_complete);
+  status.set_tasks_leased(leases_.count_for_job(record.id));
+  status.set_has_result(has_result(job));
+  *status.mutable_warnings() = job.stored.warnings();
   status.set_compute_seconds(record.compute_seconds);
   if (record.started_unix_ms) {
     int64_t end =
@@ -772,14 +850,24 @@ v1::JobStatus Coordinator::status_locked(const Job& job, bool with_curve) const 
 }
 
 v1::JobStatus Coordinator::status(const std::string& job_id, bool with_curve) {
+  return status(CallContext::internal(), job_id, with_curve);
+}
+
+v1::JobStatus Coordinator::status(const CallContext& caller, const std::string& job_id,
+                                  bool with_curve) {
   std::lock_guard lock(mutex_);
-  return status_locked(job_locked(job_id), with_curve);
+  return status_locked(job_locked(job_id, caller), with_curve);
 }
 
 std::vector<v1::JobStatus> Coordinator::list() {
+  return list(CallContext::internal());
+}
+
+std::vector<v1::JobStatus> Coordinator::list(const CallContext& caller) {
   std::lock_guard lock(mutex_);
   std::vector<v1::JobStatus> result;
-  for (const auto& [id, job] : jobs_) result.push_back(status_locked(*job, false));
+  for (const auto& [id, job] : jobs_)
+    if (caller.may_see(job->spec().owner())) result.push_back(status_locked(*job, false));
   return result;
 }
 
@@ -793,15 +881,16 @@ std::vector<std::string> Coordinator::unfinished_jobs_in_batch(const std::string
 }
 
 v1::JobState Coordinator::cancel(const std::string& job_id) {
+  return cancel(CallContext::internal(), job_id);
+}
+
+v1::JobState Coordinator::cancel(const CallContext& caller, const std::string& job_id) {
   Notifications notifications;
   v1::JobState state;
   {
     std::lock_guard lock(mutex_);
-    Job& job = job_locked(job_id);
-    if (!is_terminal(job.record.state)) {
-      end_job(job, v1::JOB_STATE_CANCELLED, "cancelled");
-      spdlog::info("{}: cancelled", job_name(job.record.id));
-    }
+    Job& job = job_locked(job_id, caller);
+    if (!is_terminal(job.record.state)) cancel_locked(job);
     state = v1::JobState(job.record.state);
     collect_notifications(job.record.id, notifications);
   }
@@ -809,15 +898,74 @@ v1::JobState Coordinator::cancel(const std::string& job_id) {
   return state;
 }
 
+// Cancelling keeps what is sealed: the blocks every tile has completed are an image of that many
+// passes, as unbiased as a job of that spp budget (every pixel has the same passes), stored as the
+// job's result with its spp in the metadata. The results of unsealed blocks are dropped (only
+// some tiles have them), but the task and tile counts stay as they were.
+void Coordinator::cancel_locked(Job& job) {
+  const v1::JobStatus before = status_locked(job, false);
+  v1::StoredJob stored = job.stored;
+  stored.set_tasks_complete_at_cancel(before.tasks_complete());
+  stored.set_tiles_complete_at_cancel(before.tiles_complete());
+  const uint32_t spp = sealed_passes(job);
+  std::optional<std::string> exr;
+  if (spp > 0 && job.scene) {
+    try {
+      Film film = assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+      exr = encode_result(job, film, spp,
+                          {{"penumbra:cancelled", "after " + std::to_string(spp) + " of " +
+                                                      std::to_string(before.passes_planned()) +
+                                                      " planned passes"}});
+      record_final_errors(job, film);
+      stored.set_has_partial_result(true);
+    } catch (const std::exception& error) {
+      spdlog::error("{}: cannot encode its sealed passes: {}", job_name(job.record.id),
+                    error.what());
+      exr.reset();
+    }
+  }
+  JobRecord record = job.record;
+  record.spec = stored.SerializeAsString();
+  record.state = v1::JOB_STATE_CANCELLED;
+  record.error.clear();
+  record.finished_unix_ms = unix_ms();
+  try {
+    store_.cancel_job(record, exr);
+  } catch (const std::exception& error) {
+    // The cancellation itself must happen: without the image when the store cannot take it.
+    spdlog::error("{}: cannot store its sealed passes: {}", job_name(job.record.id), error.what());
+    stored.set_has_partial_result(false);
+    record.spec = stored.SerializeAsString();
+    record.error = std::string("the sealed passes could not be stored: ") + error.what();
+  }
+  job.stored = std::move(stored);
+  job.record = record;
+  end_job(job, v1::JOB_STATE_CANCELLED, record.error);
+  spdlog::info("{}: cancelled; {} sealed passes kept", job_name(job.record.id),
+               job.stored.has_partial_result() ? spp : 0);
+}
+
+bool Coordinator::has_result(const Job& job) {
+  return job.record.state == v1::JOB_STATE_DONE ||
+         (job.record.state == v1::JOB_STATE_CANCELLED && job.stored.has_partial_result());
+}
+
 std::string Coordinator::result_exr(const std::string& job_id) {
+  return result_exr(CallContext::internal(), job_id);
+}
+
+std::string Coordinator::result_exr(const CallContext& caller, const std::string& job_id) {
   uint64_t id;
   {
     std::lock_guard lock(mutex_);
-    Job& job = job_locked(job_id);
-    if (job.record.state != v1::JOB_STATE_DONE)
+    Job& job = job_locked(job_id, caller);
+    if (!has_result(job))
       throw FarmError(FarmErrorCode::FailedPrecondition,
                       job_id + " has no result: it is " +
                           v1::JobState_Name(v1::JobState(job.record.state)) +
+                          (job.record.state == v1::JOB_STATE_CANCELLED
+                               ? " (cancelled before any pass was sealed)"
+                               : "") +
                           (job.record.error.empty() ? "" : " (" + job.record.error + ")"));
     id = job.record.id;
   }
@@ -833,8 +981,13 @@ Film Coordinator::result_film(const std::string& job_id) {
 }
 
 uint64_t Coordinator::subscribe(const std::string& job_id, std::function<void()> on_change) {
+  return subscribe(CallContext::internal(), job_id, std::move(on_change));
+}
+
+uint64_t Coordinator::subscribe(const CallContext& caller, const std::string& job_id,
+                                std::function<void()> on_change) {
   std::lock_guard lock(mutex_);
-  uint64_t id = job_locked(job_id).record.id;
+  uint64_t id = job_locked(job_id, caller).record.id;
   uint64_t subscription = next_subscription_++;
   subscriptions_[subscription] = {id, std::move(on_change)};
   return subscription;
@@ -876,11 +1029,36 @@ v1::RegisterResponse Coordinator::register_worker(const v1::RegisterRequest& req
                         "\"; rebuild the worker from the same source "
                         "with the same compiler and flags");
   if (request.threads() == 0) throw invalid("threads: a worker needs at least one thread");
+  // The worker's id is its name, so a worker keeps its id across restarts. A name held by a
+  // live worker is refused (two processes under one id would share leases); a dead one's is
+  // taken over. Without a name: w1, w2, ...
   std::lock_guard lock(mutex_);
-  std::string id = "w" + std::to_string(next_worker_++) + "-" +
-                   (request.name().empty() ? std::string("worker") : request.name());
+  std::string id = request.name();
+  if (id.empty()) {
+    do id = fmt::format("w{}", next_worker_++);
+    while (workers_.count(id));
+  } else if (auto held = workers_.find(id); held != workers_.end() && !held->second.dead) {
+    const double since =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - held->second.last_contact)
+            .count();
+    if (since <= std::chrono::duration<double>(dead_after()).count())
+      throw FarmError(FarmErrorCode::AlreadyExists,
+                      fmt::format("a live worker is registered as \"{}\" (heard from {:.1f} s "
+                                  "ago): give each worker its own --name (a restarted worker "
+                                  "gets its name back once the old one has missed its "
+                                  "heartbeats)",
+                                  id, since));
+  }
+  if (auto previous = workers_.find(id); previous != workers_.end()) {
+    // A restart: whatever the previous process held is lost with it.
+    for (const Lease& lease : leases_.release_worker(id)) {
+      scheduler_.requeue(lease.task);
+      ++counters_.leases_expired;
+    }
+    workers_.erase(previous);
+  }
   Worker& worker = workers_[id];
-  worker.name = request.name();
+  worker.name = request.name().empty() ? id : request.name();
   worker.threads = request.threads();
   worker.version = request.version();
   worker.build_flavour = request.build_flavour();
@@ -890,7 +1068,7 @@ v1::RegisterResponse Coordinator::register_worker(const v1::RegisterRequest& req
   response.set_worker_id(id);
   double lease_seconds = std::chrono::duration<double>(options_.lease_time).count();
   response.set_lease_seconds(lease_seconds);
-  response.set_heartbeat_seconds(lease_seconds / 3);
+  response.set_heartbeat_seconds(std::chrono::duration<double>(heartbeat_period()).count());
   return response;
 }
 
@@ -900,6 +1078,12 @@ Coordinator::Worker& Coordinator::worker_locked(const std::string& worker_id) {
     throw FarmError(FarmErrorCode::NotFound,
                     "no worker " + worker_id + " (register again: the coordinator restarted?)");
   it->second.last_contact = std::chrono::steady_clock::now();
+  if (it->second.dead) {
+    // Back after it was declared dead: its old leases are gone (its heartbeat hears that they
+    // are revoked); it leases anew.
+    it->second.dead = false;
+    spdlog::info("worker {} is back", worker_id);
+  }
   return it->second;
 }
 
@@ -1006,6 +1190,8 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
       ++worker->second.tasks_completed;
       worker->second.compute_seconds += request.compute_seconds();
       worker->second.last_contact = std::chrono::steady_clock::now();
+      // Delivering a result is contact for as long as the durable write takes.
+      ++worker->second.calls_in_flight;
     }
     job.record.compute_seconds += request.compute_seconds();
     ++job.tasks_completed_ever;
@@ -1016,11 +1202,18 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
   }
   // The durable write happens outside the lock, so that concurrent completions share one
   // transaction (Store::add_task_result commits them as a group).
+  auto call_done = [&] {  // under mutex_
+    auto worker = workers_.find(request.worker_id());
+    if (worker == workers_.end() || worker->second.calls_in_flight == 0) return;
+    --worker->second.calls_in_flight;
+    worker->second.last_contact = std::chrono::steady_clock::now();
+  };
   try {
     store_.add_task_result(job_id, {task_index, request.tile(), request.compute_seconds()});
   } catch (const std::exception& error) {
     {
       std::lock_guard lock(mutex_);
+      call_done();
       Job& job = *jobs_.at(job_id);
       if (!is_terminal(job.record.state) && job.pending.erase(task_index)) {
         job.record.compute_seconds -= request.compute_seconds();
@@ -1036,6 +1229,7 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
   Notifications notifications;
   {
     std::lock_guard lock(mutex_);
+    call_done();
     Job& job = *jobs_.at(job_id);
     auto it = job.pending.find(task_index);
     if (!is_terminal(job.record.state) && it != job.pending.end()) {
@@ -1088,6 +1282,39 @@ void Coordinator::expire_leases() {
       scheduler_.requeue(lease.task);
       ++counters_.leases_expired;
     }
+    // Dead workers: their tasks go to the others now, not when the leases would expire.
+    const auto now = std::chrono::steady_clock::now();
+    for (auto it = workers_.begin(); it != workers_.end();) {
+      Worker& worker = it->second;
+      const auto silence = now - worker.last_contact;
+      if (!worker.dead && worker.calls_in_flight == 0 && silence > dead_after()) {
+        worker.dead = true;
+        ++counters_.workers_lost;
+        std::vector<Lease> lost = leases_.release_worker(it->first);
+        std::sort(lost.begin(), lost.end(), [](const Lease& a, const Lease& b) {
+          return std::tuple(a.task.job_id, a.task.task_index) >
+                 std::tuple(b.task.job_id, b.task.task_index);
+        });
+        for (const Lease& lease : lost) {
+          scheduler_.requeue(lease.task);
+          ++counters_.leases_expired;
+          collect_notifications(lease.task.job_id, notifications);
+        }
+        spdlog::warn(
+            "worker {} silent for {:.2f} s ({} heartbeats missed): dead; {} task(s) "
+            "queued again",
+            it->first, std::chrono::duration<double>(silence).count(), options_.missed_heartbeats,
+            lost.size());
+      }
+      if (worker.dead && options_.forget_worker_after.count() > 0 &&
+          silence > options_.forget_worker_after) {
+        spdlog::info("worker {} forgotten (dead for {:.0f} s)", it->first,
+                     std::chrono::duration<double>(silence).count());
+        it = workers_.erase(it);
+        continue;
+      }
+      ++it;
+    }
     // Seal or finish again what a failed store write left (space may have returned).
     for (auto& [id, job] : jobs_) {
       if (!job->store_retry || is_terminal(job->record.state)) continue;
@@ -1100,14 +1327,24 @@ void Coordinator::expire_leases() {
 }
 
 Film Coordinator::preview_film(const std::string& job_id, uint32_t* passes) {
-  std::lock_guard lock(mutex_);
-  const Job& job = job_locked(job_id);
-  if (passes)
-    *passes =
-        job.record.blocks_sealed == 0
-            ? 0
-            : task_passes(job, uint64_t(job.record.blocks_sealed) * job.tile_count - 1).second;
-  return assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+  uint64_t id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    const Job& job = job_locked(job_id);
+    if (passes) *passes = sealed_passes(job);
+    // An ended job's sums are gone from memory: its image is the stored result (a done job's,
+    // a cancelled job's sealed passes). A failed job has none: black.
+    if (!has_result(job))
+      return assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+    if (!is_terminal(job.record.state))
+      return assemble_film(int(job.stored.width()), int(job.stored.height()), job.sealed);
+    id = job.record.id;
+  }
+  auto exr = store_.result(id);
+  if (!exr) throw FarmError(FarmErrorCode::Internal, job_id + ": the stored result is missing");
+  Film film;
+  film.color = decode_exr(*exr, nullptr, &film.variance);
+  return film;
 }
 
 CoordinatorCounters Coordinator::counters() const {
@@ -1131,7 +1368,7 @@ std::vector<v1::WorkerInfo> Coordinator::workers() {
     info.set_build_flavour(worker.build_flavour);
     double since = std::chrono::duration<double>(now - worker.last_contact).count();
     info.set_seconds_since_heartbeat(since);
-    info.set_alive(since <= std::chrono::duration<double>(options_.lease_time).count());
+    info.set_alive(!worker.dead && since <= std::chrono::duration<double>(dead_after()).count());
     info.set_tasks_leased(uint32_t(leases_.count_for_worker(id)));
     info.set_tasks_completed(worker.tasks_completed);
     info.set_compute_seconds(worker.compute_seconds);

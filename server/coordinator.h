@@ -37,8 +37,10 @@
 #include "core/render/tile.h"
 #include "core/scene/scene.h"
 #include "penumbra/v1/farm.pb.h"
+#include "server/call_context.h"
 #include "server/farm_error.h"
 #include "server/lease_table.h"
+#include "server/scene_transfer.h"
 #include "server/scheduler.h"
 #include "server/store.h"
 
@@ -46,7 +48,16 @@ namespace penumbra::farm {
 
 struct CoordinatorOptions {
   std::string data_dir;
+  // A lease not extended for this long expires and its task is queued again: the fence that
+  // makes a late result of a lost lease recognisable (only the current attempt token counts).
   std::chrono::milliseconds lease_time{30'000};
+  // Workers heartbeat every heartbeat_interval (at most lease_time / 3); any call counts as
+  // contact. A worker silent for missed_heartbeats intervals and half an interval more is dead:
+  // its leases are revoked and its tasks queued again at once, long before they would expire.
+  std::chrono::milliseconds heartbeat_interval{1'000};
+  uint32_t missed_heartbeats = 2;
+  // A dead worker leaves the worker list after this long (0: never).
+  std::chrono::milliseconds forget_worker_after{300'000};
   uint32_t default_tile_size = 64;
   uint32_t default_passes_per_task = 8;
   size_t max_scene_bytes = size_t(256) << 20;
@@ -67,7 +78,8 @@ struct CoordinatorCounters {
   uint64_t tasks_completed = 0;  // results accepted
   uint64_t tasks_failed = 0;     // FailTask calls that released a lease
   uint64_t late_results = 0;     // late or duplicate results dropped
-  uint64_t leases_expired = 0;   // leases that timed out and were queued again
+  uint64_t leases_expired = 0;   // leases that timed out, or of dead workers, queued again
+  uint64_t workers_lost = 0;     // workers declared dead (missed heartbeats)
   uint64_t jobs_submitted = 0;
   uint64_t queued_tasks = 0;  // gauge: tasks waiting for a worker
   uint64_t leased_tasks = 0;  // gauge: tasks held by workers now
@@ -85,7 +97,12 @@ class Coordinator {
   Coordinator(const Coordinator&) = delete;
   Coordinator& operator=(const Coordinator&) = delete;
 
-  // Jobs (clients). A client's spec.batch_id is ignored.
+  // Jobs (clients). A client's spec.batch_id is ignored. The calls taking a CallContext act for
+  // that caller (server/call_context.h): what it submits is owned by caller.client (its
+  // spec.owner is replaced; a reference_job must be one it may see), and another owner's job is
+  // NOT_FOUND exactly like an unknown id. The calls without one are the coordinator's own
+  // (batch manager, HTTP side): every job, spec.owner kept.
+  v1::SubmitJobResponse submit(const CallContext& caller, const v1::JobSpec& spec);
   v1::SubmitJobResponse submit(const v1::JobSpec& spec);
   // A job of a batch (server/batch_manager.h): served round-robin with the batch's other jobs.
   // `awaits_pass_count` (a seconds budget): once that budget is spent the job waits, RUNNING
@@ -108,22 +125,33 @@ class Coordinator {
   // Stores a scene package (already parsed and validated by the caller) under its hash, so
   // jobs may name it by scene_hash.
   void store_scene(const std::string& scene_hash, const v1::ScenePackage& package);
+  v1::JobStatus status(const CallContext& caller, const std::string& job_id,
+                       bool with_curve = true);
   v1::JobStatus status(const std::string& job_id, bool with_curve = true);
+  // The jobs the caller may see, by id.
+  std::vector<v1::JobStatus> list(const CallContext& caller);
   std::vector<v1::JobStatus> list();
   // The ids of the batch's jobs (submit_in_batch) that have not ended.
   std::vector<std::string> unfinished_jobs_in_batch(const std::string& batch_id);
+  v1::JobState cancel(const CallContext& caller, const std::string& job_id);
   v1::JobState cancel(const std::string& job_id);
+  // The result EXR: a done job's, or a cancelled job's sealed passes (JobStatus.has_result);
+  // FailedPrecondition without one.
+  std::string result_exr(const CallContext& caller, const std::string& job_id);
   std::string result_exr(const std::string& job_id);
   // The finished job's image (decoded from its EXR).
   Film result_film(const std::string& job_id);
-  // A running or finished job's image so far: the sealed pass blocks of every tile (tiles with
-  // none are black). For live previews; the pass count is returned in `passes`.
+  // A job's image so far: the sealed pass blocks of every tile (tiles with none are black); an
+  // ended job's stored result (black for a failed job). For previews; the pass count is
+  // returned in `passes`.
   Film preview_film(const std::string& job_id, uint32_t* passes = nullptr);
   std::vector<v1::WorkerInfo> workers();
   CoordinatorCounters counters() const;
 
   // Calls `on_change` (from any thread, never under the coordinator's lock) whenever the job's
   // status may have changed. Returns an id for unsubscribe.
+  uint64_t subscribe(const CallContext& caller, const std::string& job_id,
+                     std::function<void()> on_change);
   uint64_t subscribe(const std::string& job_id, std::function<void()> on_change);
   void unsubscribe(uint64_t subscription);
 
@@ -136,12 +164,19 @@ class Coordinator {
   bool complete_task(const v1::CompleteTaskRequest& request);
   void fail_task(const v1::FailTaskRequest& request);
 
-  // Requeues tasks whose leases expired (a background thread calls it every lease_time / 4).
+  // Requeues the tasks of dead workers and those whose leases expired, and forgets workers dead
+  // for forget_worker_after (a background thread calls it every heartbeat / 4).
   void expire_leases();
+  // The heartbeat period workers are told (heartbeat_interval, at most lease_time / 3) and the
+  // silence after which a worker is dead.
+  std::chrono::milliseconds heartbeat_period() const;
+  std::chrono::milliseconds dead_after() const;
 
   static std::string job_name(uint64_t job_id);
   const CoordinatorOptions& options() const { return options_; }
   const SceneParser& scene_parser() const { return parser_; }
+  // Scenes in chunks: clients' uploads, workers' fetches (server/scene_transfer.h).
+  SceneTransfer& scene_transfer() { return transfer_; }
   // The scheduler group of a batch id ("batch-3" -> 3); 0 (no group) for anything else.
   static uint64_t batch_group(const std::string& batch_id);
 
@@ -152,20 +187,35 @@ class Coordinator {
     uint32_t threads = 0;
     std::string version, build_flavour;
     SteadyTime last_contact;
+    bool dead = false;        // missed its heartbeats: its leases were revoked
+    int calls_in_flight = 0;  // results being stored: the worker is in contact meanwhile
     uint64_t tasks_completed = 0;
     double compute_seconds = 0;
   };
   using Notifications = std::vector<std::function<void()>>;
 
-  v1::SubmitJobResponse submit_spec(v1::JobSpec spec, bool awaits_pass_count = false);
+  v1::SubmitJobResponse submit_spec(v1::JobSpec spec, bool awaits_pass_count = false,
+                                    const CallContext& caller = CallContext::internal());
   uint64_t parse_job_id(const std::string& job_id) const;
-  Job& job_locked(const std::string& job_id);
+  // NotFound for an unknown id and for a job the caller may not see (the same message).
+  Job& job_locked(const std::string& job_id, const CallContext& caller = CallContext::internal());
   Worker& worker_locked(const std::string& worker_id);
   void resume(const JobRecord& record);
   void open_block(Job& job);
   void maybe_open_block(Job& job);
   void seal_ready_blocks(Job& job);
   void finish(Job& job);
+  void cancel_locked(Job& job);
+  // Passes every tile has (the sealed blocks').
+  uint32_t sealed_passes(const Job& job) const;
+  // The EXR of `film` (the job's sealed passes, `spp` of them) with the job's metadata and
+  // `extra`.
+  std::string encode_result(const Job& job, const Film& film, uint32_t spp,
+                            const ImageMetadata& extra) const;
+  // The errors of `film` against the job's reference, per region (none without a reference).
+  void record_final_errors(Job& job, const Film& film);
+  // A done job, or a cancelled one whose sealed passes were stored.
+  static bool has_result(const Job& job);
   void end_job(Job& job, v1::JobState state, const std::string& error);
   void load_reference(Job& job);
   bool waits_for_pass_count(const Job& job) const;
@@ -182,6 +232,7 @@ class Coordinator {
   CoordinatorOptions options_;
   SceneParser parser_;
   Store store_;
+  SceneTransfer transfer_;
   mutable std::mutex mutex_;
   std::map<uint64_t, std::unique_ptr<Job>> jobs_;
   Scheduler scheduler_;

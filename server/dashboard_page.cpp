@@ -1,5 +1,9 @@
 #include "server/dashboard_page.h"
 
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+
 namespace penumbra::farm {
 
 namespace {
@@ -77,8 +81,12 @@ function el(tag, attributes, ...children) {
     node.append(child instanceof Node ? child : document.createTextNode(String(child)));
   return node;
 }
+// A token in the page's address (?token=...) goes to the JSON API as a header; only images,
+// which cannot carry headers, put it in their address.
+const token = new URLSearchParams(location.search).get("token");
 async function getJSON(url) {
-  const response = await fetch(url, {cache: "no-store"});
+  const headers = token ? {Authorization: "Bearer " + token} : {};
+  const response = await fetch(url, {cache: "no-store", headers: headers});
   if (!response.ok) throw new Error(url + ": HTTP " + response.status);
   return response.json();
 }
@@ -188,7 +196,8 @@ function renderPreview(job) {
   previewJob = job.job_id;
   previewPasses = passes;
   document.getElementById("preview").src =
-      "/api/jobs/" + encodeURIComponent(job.job_id) + "/preview.png?passes=" + passes;
+      "/api/jobs/" + encodeURIComponent(job.job_id) + "/preview.png?passes=" + passes +
+      (token ? "&token=" + encodeURIComponent(token) : "");
 }
 
 function pick(jobs) {
@@ -232,10 +241,153 @@ setInterval(tick, 1000);
 </html>
 )PAGE";
 
+std::string escape_html(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string state_name(v1::JobState state) {
+  std::string name = v1::JobState_Name(state);
+  if (name.rfind("JOB_STATE_", 0) == 0) name = name.substr(10);
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return name;
+}
+
+bool is_terminal(v1::JobState state) {
+  return state == v1::JOB_STATE_DONE || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+// The script's progress(): passes for an spp budget, compute seconds for a seconds budget.
+double progress(const v1::JobStatus& job) {
+  if (job.state() == v1::JOB_STATE_DONE) return 1;
+  if (job.spp_budget() > 0) return std::min(1.0, double(job.passes_complete()) / job.spp_budget());
+  if (job.seconds_budget() > 0) return std::min(1.0, job.compute_seconds() / job.seconds_budget());
+  return 0;
+}
+
+std::string bar(double fraction, const std::string& state) {
+  char text[160];
+  std::snprintf(text, sizeof text, "<div class=\"bar %s\"><div style=\"width:%.1f%%\"></div></div>",
+                state.c_str(), 100 * fraction);
+  return text;
+}
+
+std::string cell(const std::string& text) {
+  return "<td>" + escape_html(text) + "</td>";
+}
+
+std::string fixed(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, value);
+  return text;
+}
+
+void replace_once(std::string& page, const std::string& from, const std::string& to,
+                  size_t& from_position) {
+  size_t at = page.find(from, from_position);
+  if (at == std::string::npos) return;
+  page.replace(at, from.size(), to);
+  from_position = at + to.size();
+}
+
 }  // namespace
 
 std::string_view dashboard_page() {
   return kPage;
+}
+
+std::string dashboard_page(const DashboardSnapshot& snapshot) {
+  std::string page(kPage);
+  int active = 0;
+  for (const v1::WorkerInfo& worker : snapshot.workers) active += worker.alive();
+  // The job the script would select first.
+  const v1::JobStatus* selected = nullptr;
+  for (const v1::JobStatus& job : snapshot.jobs)
+    if (!is_terminal(job.state())) selected = &job;
+  if (!selected && !snapshot.jobs.empty()) selected = &snapshot.jobs.back();
+
+  std::string summary = "<div id=\"summary\"><span>queue depth <b id=\"queue-depth\">" +
+                        std::to_string(snapshot.queue_depth) + "</b></span><span>leased <b>" +
+                        std::to_string(snapshot.leased_tasks) +
+                        "</b></span><span>completed <b id=\"tasks-completed\">" +
+                        std::to_string(snapshot.tasks_completed) +
+                        "</b></span><span>active workers <b id=\"workers-active\">" +
+                        std::to_string(active) + "</b></span></div>";
+  std::string jobs;
+  for (auto it = snapshot.jobs.rbegin(); it != snapshot.jobs.rend(); ++it) {
+    const v1::JobStatus& job = *it;
+    const double fraction = progress(job);
+    const std::string state = state_name(job.state());
+    char mrse[32] = "\u2013";
+    if (job.has_mrse()) std::snprintf(mrse, sizeof mrse, "%.3e", job.mrse());
+    jobs += "<tr class=\"job" + std::string(selected == &job ? " selected" : "") +
+            "\" data-job-id=\"" + escape_html(job.job_id()) + "\" data-state=\"" + state +
+            "\" data-passes=\"" + std::to_string(job.passes_complete()) + "\" data-progress=\"" +
+            fixed(fraction, 4) + "\">" + cell(job.job_id()) + cell(job.name()) +
+            cell(job.scene_name()) + cell(job.method()) + cell(state) + "<td>" +
+            bar(fraction, state) + " " + fixed(100 * fraction, 0) + "%</td>" +
+            cell(std::to_string(job.passes_complete()) +
+                 (job.spp_budget() ? " / " + std::to_string(job.spp_budget()) : "")) +
+            cell(mrse) + cell(fixed(job.compute_seconds(), 1)) + "</tr>\n";
+  }
+  std::string workers;
+  for (const v1::WorkerInfo& worker : snapshot.workers) {
+    const double load =
+        worker.threads() > 0 ? std::min(1.0, double(worker.tasks_leased()) / worker.threads()) : 0;
+    workers +=
+        "<tr class=\"worker\" data-worker-id=\"" + escape_html(worker.worker_id()) +
+        "\" data-alive=\"" + (worker.alive() ? "true" : "false") + "\">" +
+        cell(worker.worker_id()) + cell(worker.name()) + cell(std::to_string(worker.threads())) +
+        cell(worker.alive() ? "yes" : "no") + "<td>" + bar(load, worker.alive() ? "" : "failed") +
+        "</td>" + cell(std::to_string(worker.tasks_leased())) +
+        cell(std::to_string(worker.tasks_completed())) + cell(fixed(worker.compute_seconds(), 1)) +
+        cell(fixed(worker.seconds_since_heartbeat(), 1) + " s ago") + "</tr>\n";
+  }
+  size_t at = 0;
+  replace_once(page, "<div id=\"summary\" class=\"muted\">loading&hellip;</div>", summary, at);
+  replace_once(page, "<tbody></tbody>", "<tbody>\n" + jobs + "</tbody>", at);
+  if (selected) {
+    replace_once(page, "<h2 id=\"detail-title\">Selected job</h2>",
+                 "<h2 id=\"detail-title\">Job " + escape_html(selected->job_id()) +
+                     (selected->name().empty() ? "" : " (" + escape_html(selected->name()) + ")") +
+                     ": " + escape_html(selected->method()) + "</h2>",
+                 at);
+    replace_once(page, "<img id=\"preview\"",
+                 "<img id=\"preview\" src=\"/api/jobs/" + escape_html(selected->job_id()) +
+                     "/preview.png?passes=" + std::to_string(selected->passes_complete()) +
+                     (snapshot.token_parameter.empty()
+                          ? ""
+                          : "&amp;token=" + escape_html(snapshot.token_parameter)) +
+                     "\"",
+                 at);
+  }
+  replace_once(page, "<tbody></tbody>", "<tbody>\n" + workers + "</tbody>", at);
+  replace_once(page, "<span id=\"updated\">never</span>",
+               "<span id=\"updated\">" + escape_html(snapshot.updated) + "</span>", at);
+  return page;
 }
 
 }  // namespace penumbra::farm

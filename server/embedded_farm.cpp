@@ -20,6 +20,7 @@ EmbeddedFarm::EmbeddedFarm(const EmbeddedFarmOptions& options) {
   CoordinatorOptions coordinator_options;
   coordinator_options.data_dir = data_dir_;
   coordinator_options.lease_time = options.lease_time;
+  coordinator_options.max_scene_bytes = options.max_scene_bytes;
   coordinator_ = std::make_unique<Coordinator>(coordinator_options, parse_wire_package);
   server_ = std::make_unique<CoordinatorServer>(*coordinator_, "127.0.0.1:0",
                                                 coordinator_options.max_scene_bytes + (16u << 20));

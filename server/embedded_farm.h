@@ -28,6 +28,7 @@ struct EmbeddedFarmOptions {
   // The coordinator's state; empty: a fresh temporary folder, removed when the farm stops.
   std::string data_dir;
   std::chrono::milliseconds lease_time{10'000};
+  size_t max_scene_bytes = size_t(256) << 20;  // the coordinator's scene-size limit
 };
 
 class EmbeddedFarm {

@@ -12,6 +12,7 @@ enum class FarmErrorCode {
   NotFound,            // unknown job, scene or worker
   ResourceExhausted,   // oversized scene, too many queued tasks
   FailedPrecondition,  // wrong build or protocol, result of a job that is not done
+  AlreadyExists,       // a worker name held by a live worker
   Internal,
 };
 

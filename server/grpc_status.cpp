@@ -17,6 +17,9 @@ grpc::Status to_status(const FarmError& error) {
     case FarmErrorCode::FailedPrecondition:
       code = grpc::StatusCode::FAILED_PRECONDITION;
       break;
+    case FarmErrorCode::AlreadyExists:
+      code = grpc::StatusCode::ALREADY_EXISTS;
+      break;
     case FarmErrorCode::Internal:
       code = grpc::StatusCode::INTERNAL;
       break;

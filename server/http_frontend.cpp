@@ -1,19 +1,24 @@
 #include "server/http_frontend.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <google/protobuf/util/json_util.h>
 #include <httplib.h>
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <ctime>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/image/metrics.h"
+#include "core/report/batch_figure.h"
+#include "core/report/comparison_viewer.h"
+#include "server/batch_manager.h"
 #include "server/dashboard_page.h"
+#include "server/status_pages.h"
 
 namespace penumbra::farm {
 
@@ -80,6 +85,39 @@ class MetricsWriter {
   std::ostringstream out_;
 };
 
+// The canonical proto3 JSON mapping prints 64-bit integers as strings (JavaScript numbers lose
+// precision past 2^53); our counts, ids, seeds and milliseconds are read by scripts and
+// dashboards as numbers, so they are turned back into JSON numbers (exact: nlohmann keeps 64-bit
+// integers).
+void int64_as_numbers(const google::protobuf::Descriptor& descriptor, nlohmann::json& json) {
+  using google::protobuf::FieldDescriptor;
+  for (int i = 0; i < descriptor.field_count(); ++i) {
+    const FieldDescriptor& field = *descriptor.field(i);
+    auto found = json.find(field.name());
+    if (found == json.end()) continue;
+    auto convert = [&](nlohmann::json& value) {
+      if (field.cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+        if (value.is_object() && !field.is_map()) int64_as_numbers(*field.message_type(), value);
+        return;
+      }
+      if (!value.is_string()) return;
+      const std::string text = value.get<std::string>();
+      try {
+        if (field.cpp_type() == FieldDescriptor::CPPTYPE_INT64)
+          value = int64_t(std::stoll(text));
+        else if (field.cpp_type() == FieldDescriptor::CPPTYPE_UINT64)
+          value = uint64_t(std::stoull(text));
+      } catch (const std::exception&) {
+        // Not a number after all: left as printed.
+      }
+    };
+    if (field.is_repeated() && found->is_array())
+      for (nlohmann::json& element : *found) convert(element);
+    else
+      convert(*found);
+  }
+}
+
 std::string to_json(const google::protobuf::Message& message) {
   google::protobuf::util::JsonPrintOptions options;
   options.always_print_primitive_fields = true;
@@ -87,32 +125,9 @@ std::string to_json(const google::protobuf::Message& message) {
   std::string json;
   auto status = google::protobuf::util::MessageToJsonString(message, &json, options);
   if (!status.ok()) throw std::runtime_error("JSON encoding failed: " + status.ToString());
-  return json;
-}
-
-double srgb_encode(double linear) {
-  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
-}
-
-// 8-bit sRGB PNG bytes of `color` scaled by `exposure` (clamped; non-finite pixels black).
-std::string encode_preview_png(const Image& color, double exposure) {
-  if (color.width <= 0 || color.height <= 0) throw std::runtime_error("empty preview image");
-  std::vector<uint8_t> pixels(color.rgb.size());
-  for (size_t i = 0; i < color.rgb.size(); ++i) {
-    double value = double(color.rgb[i]) * exposure;
-    if (!std::isfinite(value)) value = 0;
-    pixels[i] = uint8_t(std::lround(srgb_encode(std::clamp(value, 0.0, 1.0)) * 255.0));
-  }
-  std::vector<unsigned char> bytes;
-  OIIO::Filesystem::IOVecOutput proxy(bytes);
-  auto output = OIIO::ImageOutput::create("png");
-  if (!output || !output->supports("ioproxy") || !output->set_ioproxy(&proxy))
-    throw std::runtime_error("no in-memory PNG writer");
-  OIIO::ImageSpec spec(color.width, color.height, 3, OIIO::TypeDesc::UINT8);
-  if (!output->open("preview.png", spec) ||
-      !output->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !output->close())
-    throw std::runtime_error("PNG encoding failed: " + output->geterror());
-  return std::string(bytes.begin(), bytes.end());
+  nlohmann::json document = nlohmann::json::parse(json);
+  int64_as_numbers(*message.GetDescriptor(), document);
+  return document.dump();
 }
 
 int http_status(FarmErrorCode code) {
@@ -124,6 +139,7 @@ int http_status(FarmErrorCode code) {
     case FarmErrorCode::ResourceExhausted:
       return 503;
     case FarmErrorCode::FailedPrecondition:
+    case FarmErrorCode::AlreadyExists:
       return 409;
     case FarmErrorCode::Internal:
       return 500;
@@ -150,6 +166,129 @@ void guarded(httplib::Response& response, Body&& body) {
 void set_json(httplib::Response& response, const std::string& json) {
   response.set_header("Cache-Control", "no-store");
   response.set_content(json + "\n", "application/json");
+}
+
+// A page for a domain error: the error's HTTP status and message.
+template <typename Body>
+void guarded_page(httplib::Response& response, Body&& body, const std::string& link_query = "") {
+  auto fail = [&](int status, const std::string& message) {
+    response.status = status;
+    response.set_content(error_page_html(status, message, link_query), "text/html; charset=utf-8");
+  };
+  try {
+    body();
+  } catch (const FarmError& error) {
+    fail(http_status(error.code()), error.what());
+  } catch (const std::exception& error) {
+    fail(500, error.what());
+  }
+}
+
+// A query parameter's value percent-encoded (RFC 3986 unreserved characters kept).
+std::string percent_encode(const std::string& text) {
+  static const char* kHex = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : text) {
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~') {
+      out += char(c);
+    } else {
+      out += '%';
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
+bool is_page(const std::string& path) {
+  return path == "/" || path.rfind("/jobs/", 0) == 0 || path.rfind("/batches/", 0) == 0;
+}
+
+// What a page appends to its links: the token when the request brought it in the address.
+std::string link_query(const HttpAuthorization& authorization, const httplib::Request& request) {
+  if (!authorization.token_from_query) return "";
+  return "?token=" + percent_encode(request.get_param_value("token"));
+}
+
+// The comparison viewer of a batch's images as the coordinator holds them: the reference EXR and,
+// per method that ran, the image of its run with the most passes (lowest repeat first): the result
+// when that job is done, else its image so far.
+// Empty with a note when there is nothing to show yet.
+std::string batch_viewer_html(Coordinator& coordinator, BatchManager& batches,
+                              const v1::BatchStatus& status, std::string& note) {
+  std::string exr;
+  try {
+    exr = batches.reference_exr(status.batch_id());
+  } catch (const std::exception& error) {
+    note = std::string("No viewer yet: the reference is not ready (") + error.what() + ").";
+    return "";
+  }
+  Image reference = decode_exr(exr);
+  std::map<std::string, Region> regions;
+  ComparisonViewerContent content;
+  content.width = reference.width;
+  content.height = reference.height;
+  for (const v1::BatchRegion& region : status.regions()) {
+    Region rect{region.rect().x0(), region.rect().y0(), region.rect().x1(), region.rect().y1()};
+    regions[region.name()] = rect;
+    content.regions.push_back({region.name(), rect});
+  }
+  content.reference = {"reference",
+                       status.reference().method(),
+                       status.reference().sampler(),
+                       status.reference().spp(),
+                       0,
+                       0,
+                       &reference,
+                       {},
+                       {},
+                       0};
+  std::vector<Image> images;
+  images.reserve(size_t(status.methods_size()));
+  std::vector<const Image*> pointers;
+  for (const v1::BatchMethodStatus& method : status.methods()) {
+    const v1::BatchRun* shown = nullptr;
+    for (const v1::BatchRun& run : method.runs())
+      if (!run.job_id().empty() && run.job().passes_complete() > 0 &&
+          (!shown || run.job().passes_complete() > shown->job().passes_complete()))
+        shown = &run;
+    if (!shown) continue;
+    // A finished job's image is its result; a running one's the sealed passes so far.
+    Film film = shown->job().state() == v1::JOB_STATE_DONE
+                    ? coordinator.result_film(shown->job_id())
+                    : coordinator.preview_film(shown->job_id());
+    if (film.color.width != reference.width || film.color.height != reference.height) continue;
+    images.push_back(std::move(film.color));
+    ViewerImage image;
+    image.label = method.label();
+    image.method = method.method();
+    image.sampler = method.sampler();
+    image.spp = shown->job().passes_complete();
+    image.repeat = int(shown->repeat());
+    image.compute_seconds = shown->job().compute_seconds();
+    image.image = &images.back();
+    for (const auto& [region, summary] : error_summary(images.back(), reference, regions))
+      image.mrse[region] = summary.mrse;
+    content.methods.push_back(std::move(image));
+    pointers.push_back(&images.back());
+  }
+  if (content.methods.empty()) {
+    note = "No viewer yet: no run has a complete pass.";
+    return "";
+  }
+  content.exposure = choose_exposure(reference);
+  // The relative error's scale: its 99th percentile over every method's image.
+  std::vector<float> errors;
+  for (const Image* image : pointers) {
+    Image map = relative_error_map(*image, reference);
+    for (size_t i = 0; i < map.rgb.size(); i += 3) errors.push_back(map.rgb[i]);
+  }
+  size_t index = std::min(errors.size() - 1, size_t(0.99 * double(errors.size())));
+  std::nth_element(errors.begin(), errors.begin() + ptrdiff_t(index), errors.end());
+  content.error_scale = errors[index] > 0 ? double(errors[index]) : 1.0;
+  content.difference_scale = choose_difference_scale(pointers, reference);
+  note.clear();
+  return comparison_viewer_html(content);
 }
 
 }  // namespace
@@ -307,10 +446,29 @@ std::string FarmMonitor::metrics_text() {
   return out.text();
 }
 
+namespace {
+
+std::unique_ptr<httplib::Server> make_server(const HttpFrontendOptions& options) {
+  if (options.tls_cert.empty() != options.tls_key.empty())
+    throw std::runtime_error("HTTP: TLS needs both a certificate and its key");
+  if (options.tls_cert.empty()) return std::make_unique<httplib::Server>();
+  auto server =
+      std::make_unique<httplib::SSLServer>(options.tls_cert.c_str(), options.tls_key.c_str());
+  if (!server->is_valid())
+    throw std::runtime_error("HTTP: cannot use the TLS certificate " + options.tls_cert +
+                             " with the key " + options.tls_key);
+  return server;
+}
+
+}  // namespace
+
 HttpFrontend::HttpFrontend(Coordinator& coordinator, const HttpFrontendOptions& options)
     : coordinator_(coordinator),
+      batches_(options.batches),
+      tokens_(options.tokens),
+      open_metrics_(options.open_metrics),
       monitor_(coordinator),
-      server_(std::make_unique<httplib::Server>()) {
+      server_(make_server(options)) {
   HttpAddress address = parse_http_address(options.address);
   int threads = std::max(1, options.threads);
   server_->new_task_queue = [threads] { return new httplib::ThreadPool(size_t(threads)); };
@@ -365,11 +523,64 @@ void HttpFrontend::sample_loop(std::chrono::milliseconds period) {
   }
 }
 
+HttpAuthorization HttpFrontend::authorize(const httplib::Request& request) const {
+  std::optional<std::string> header, parameter;
+  if (request.has_header("Authorization")) header = request.get_header_value("Authorization");
+  if (request.has_param("token")) parameter = request.get_param_value("token");
+  return authorize_http(tokens_.get(),
+                        header ? std::optional<std::string_view>(*header) : std::nullopt,
+                        parameter ? std::optional<std::string_view>(*parameter) : std::nullopt);
+}
+
 void HttpFrontend::route() {
   httplib::Server& server = *server_;
-  server.Get("/", [](const httplib::Request&, httplib::Response& response) {
+  server.set_default_headers({{"Referrer-Policy", "no-referrer"},
+                              {"X-Content-Type-Options", "nosniff"},
+                              {"X-Frame-Options", "DENY"}});
+  // Every request is checked before routing (an unknown path without a token is 401 too, so the
+  // routes say nothing to a caller without one); the handlers then ask whose it is.
+  server.set_pre_routing_handler([this](const httplib::Request& request,
+                                        httplib::Response& response) {
+    using Result = httplib::Server::HandlerResponse;
+    if (request.path == "/healthz" || (request.path == "/metrics" && open_metrics_))
+      return Result::Unhandled;
+    HttpAuthorization authorization = authorize(request);
+    int status = authorization.status;
+    std::string message = authorization.message;
+    if (status == 200 && request.path == "/metrics" && !authorization.sees_farm) {
+      status = 403;
+      message = "/metrics names every client's jobs: it needs a viewer or admin token";
+    }
+    if (status == 200) return Result::Unhandled;
+    response.status = status;
+    if (status == 401) response.set_header("WWW-Authenticate", "Bearer realm=\"penumbra\"");
     response.set_header("Cache-Control", "no-store");
-    response.set_content(std::string(dashboard_page()), "text/html; charset=utf-8");
+    if (is_page(request.path))
+      response.set_content(error_page_html(status, message), "text/html; charset=utf-8");
+    else
+      response.set_content(nlohmann::json{{"error", message}}.dump() + "\n", "application/json");
+    return Result::Handled;
+  });
+  server.Get("/", [this](const httplib::Request& request, httplib::Response& response) {
+    guarded(response, [&] {
+      HttpAuthorization authorization = authorize(request);
+      // The first state is rendered here: the page shows the farm without JavaScript too.
+      DashboardSnapshot snapshot;
+      snapshot.jobs = coordinator_.list(authorization.caller);
+      if (authorization.token_from_query)
+        snapshot.token_parameter = percent_encode(request.get_param_value("token"));
+      snapshot.workers = coordinator_.workers();
+      CoordinatorCounters counters = coordinator_.counters();
+      snapshot.queue_depth = counters.queued_tasks;
+      snapshot.leased_tasks = counters.leased_tasks;
+      snapshot.tasks_completed = counters.tasks_completed;
+      std::time_t now = std::time(nullptr);
+      char text[32];
+      std::strftime(text, sizeof text, "%H:%M:%S", std::localtime(&now));
+      snapshot.updated = std::string(text) + " (server)";
+      response.set_header("Cache-Control", "no-store");
+      response.set_content(dashboard_page(snapshot), "text/html; charset=utf-8");
+    });
   });
   server.Get("/healthz", [this](const httplib::Request&, httplib::Response& response) {
     guarded(response, [&] {
@@ -401,19 +612,21 @@ void HttpFrontend::route() {
       set_json(response, json.dump());
     });
   });
-  server.Get("/api/jobs", [this](const httplib::Request&, httplib::Response& response) {
+  server.Get("/api/jobs", [this](const httplib::Request& request, httplib::Response& response) {
     guarded(response, [&] {
       v1::ListJobsResponse list;
-      for (v1::JobStatus& job : coordinator_.list()) *list.add_jobs() = std::move(job);
+      for (v1::JobStatus& job : coordinator_.list(authorize(request).caller))
+        *list.add_jobs() = std::move(job);
       set_json(response, to_json(list));
     });
   });
-  server.Get(R"(/api/jobs/([A-Za-z0-9_.-]+))",
-             [this](const httplib::Request& request, httplib::Response& response) {
-               guarded(response, [&] {
-                 set_json(response, to_json(coordinator_.status(request.matches[1], true)));
-               });
-             });
+  server.Get(R"(/api/jobs/([A-Za-z0-9_.-]+))", [this](const httplib::Request& request,
+                                                      httplib::Response& response) {
+    guarded(response, [&] {
+      set_json(response,
+               to_json(coordinator_.status(authorize(request).caller, request.matches[1], true)));
+    });
+  });
   server.Get(R"(/api/jobs/([A-Za-z0-9_.-]+)/preview\.png)", [this](const httplib::Request& request,
                                                                    httplib::Response& response) {
     guarded(response, [&] {
@@ -427,13 +640,48 @@ void HttpFrontend::route() {
         if (!std::isfinite(exposure) || exposure < 0)
           throw FarmError(FarmErrorCode::InvalidArgument, "exposure must be a finite number >= 0");
       }
+      coordinator_.status(authorize(request).caller, request.matches[1], false);  // NotFound
       uint32_t passes = 0;
       Film film = coordinator_.preview_film(request.matches[1], &passes);
       response.set_header("Cache-Control", "no-store");
       response.set_header("X-Penumbra-Passes", std::to_string(passes));
-      response.set_content(encode_preview_png(film.color, exposure), "image/png");
+      response.set_content(encode_png_preview(film.color, exposure), "image/png");
     });
   });
+  server.Get(R"(/jobs/([A-Za-z0-9_.-]+))", [this](const httplib::Request& request,
+                                                  httplib::Response& response) {
+    HttpAuthorization authorization = authorize(request);
+    std::string query = link_query(authorization, request);
+    guarded_page(
+        response,
+        [&] {
+          response.set_header("Cache-Control", "no-store");
+          response.set_content(
+              job_page_html(coordinator_.status(authorization.caller, request.matches[1], true),
+                            query),
+              "text/html; charset=utf-8");
+        },
+        query);
+  });
+  server.Get(R"(/batches/([A-Za-z0-9_.-]+))",
+             [this](const httplib::Request& request, httplib::Response& response) {
+               HttpAuthorization authorization = authorize(request);
+               std::string query = link_query(authorization, request);
+               guarded_page(
+                   response,
+                   [&] {
+                     if (!batches_)
+                       throw FarmError(FarmErrorCode::NotFound, "this server has no batches");
+                     v1::BatchStatus status =
+                         batches_->status(request.matches[1], false, authorization.caller);
+                     std::string note;
+                     std::string viewer = batch_viewer_html(coordinator_, *batches_, status, note);
+                     response.set_header("Cache-Control", "no-store");
+                     response.set_content(batch_page_html(status, viewer, note, query),
+                                          "text/html; charset=utf-8");
+                   },
+                   query);
+             });
   server.Get("/api/workers", [this](const httplib::Request&, httplib::Response& response) {
     guarded(response, [&] {
       v1::ListWorkersResponse list;

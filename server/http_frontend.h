@@ -11,9 +11,27 @@
 //   GET /api/jobs/<id>                 one job's status with its error-against-time curve
 //   GET /api/jobs/<id>/preview.png     the job's image so far, tone-mapped (?exposure=x)
 //   GET /api/workers                   the workers the coordinator knows
+//   GET /jobs/<id>                     a job's page: state, progress, preview, MRSE chart, errors
+//   GET /batches/<id>                  a batch's page: progress, runs, refusals, the comparison
+//                                      viewer of its images (server/status_pages.h)
 //
-// JSON bodies are the protobuf messages of penumbra/v1/farm.proto in the canonical proto3 JSON
-// mapping (field names as in the .proto, every field printed, 64-bit integers as strings).
+// Access (HttpFrontendOptions::tokens, the coordinator's --tokens-file; server/auth.h
+// authorize_http): with tokens every route but /healthz needs a token, sent as an
+// "Authorization: Bearer <token>" header (scripts, curl, Prometheus) or as a "token" query
+// parameter (a browser: the pages carry it on in their links and image addresses, the dashboard's
+// script sends it to the JSON API as a header). No or an unknown token: 401 with
+// "WWW-Authenticate: Bearer"; a worker token: 403. A client token sees its own jobs and batches
+// (another's are 404, like an unknown id) and the farm's aggregate figures (summary, workers),
+// not /metrics (it names every job: 403); viewer and admin tokens see everything. /metrics is
+// open without a token only with open_metrics. Nothing on this side changes the farm and no
+// cookie is set, so a page of another site cannot make a browser act here (no CSRF); every
+// answer carries "Referrer-Policy: no-referrer" so a token in an address does not leave in a
+// Referer header. With tls_cert and tls_key the side serves HTTPS only.
+//
+// JSON bodies are the protobuf messages of penumbra/v1/farm.proto in the proto3 JSON mapping
+// (field names as in the .proto, every field printed), except that 64-bit integers are JSON
+// numbers (exact), not strings. GET / renders the farm's state on the server (tables, preview):
+// the page is readable without JavaScript; its script then keeps it live.
 
 #include <atomic>
 #include <chrono>
@@ -28,13 +46,17 @@
 #include <thread>
 #include <vector>
 
+#include "server/auth.h"
 #include "server/coordinator.h"
 
 namespace httplib {
 class Server;
-}
+struct Request;
+}  // namespace httplib
 
 namespace penumbra::farm {
+
+class BatchManager;
 
 struct HttpAddress {
   std::string host;
@@ -81,7 +103,11 @@ class FarmMonitor {
 struct HttpFrontendOptions {
   std::string address = "127.0.0.1:0";  // see parse_http_address; port 0 picks a free one
   std::chrono::milliseconds sample_period{200};
-  int threads = 2;  // request threads
+  int threads = 2;                           // request threads
+  BatchManager* batches = nullptr;           // serves /batches/<id> when given
+  std::shared_ptr<const TokenTable> tokens;  // null: authentication off, every route open
+  bool open_metrics = false;                 // /metrics without a token
+  std::string tls_cert, tls_key;             // PEM files: serve HTTPS (both or neither)
 };
 
 class HttpFrontend {
@@ -98,9 +124,13 @@ class HttpFrontend {
 
  private:
   void route();
+  HttpAuthorization authorize(const httplib::Request& request) const;
   void sample_loop(std::chrono::milliseconds period);
 
   Coordinator& coordinator_;
+  BatchManager* batches_ = nullptr;
+  std::shared_ptr<const TokenTable> tokens_;
+  bool open_metrics_ = false;
   FarmMonitor monitor_;
   std::unique_ptr<httplib::Server> server_;
   std::string host_;

@@ -65,6 +65,19 @@ std::vector<Lease> LeaseTable::release_job(uint64_t job_id) {
   return released;
 }
 
+std::vector<Lease> LeaseTable::release_worker(const std::string& worker_id) {
+  std::vector<Lease> released;
+  for (auto it = leases_.begin(); it != leases_.end();) {
+    if (it->second.worker_id == worker_id) {
+      released.push_back(std::move(it->second));
+      it = leases_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return released;
+}
+
 size_t LeaseTable::count_for_worker(const std::string& worker_id) const {
   size_t count = 0;
   for (const auto& [token, lease] : leases_) count += lease.worker_id == worker_id;

@@ -40,6 +40,8 @@ class LeaseTable {
   std::vector<Lease> expire(SteadyTime now);
   // Removes and returns the leases of a job (cancelled or failed).
   std::vector<Lease> release_job(uint64_t job_id);
+  // Removes and returns the leases a worker holds (it is dead).
+  std::vector<Lease> release_worker(const std::string& worker_id);
   size_t count_for_worker(const std::string& worker_id) const;
   size_t count_for_job(uint64_t job_id) const;
   size_t size() const { return leases_.size(); }

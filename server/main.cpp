@@ -32,8 +32,24 @@ int main(int argc, char** argv) {
                  "port)");
   app.add_option("--data-dir", data_dir, "folder of the SQLite state (created when missing)");
   app.add_option("--port-file", port_file, "write the port it listens on to this file");
-  app.add_option("--lease-seconds", lease_seconds, "a lease not extended this long expires")
-      ->check(CLI::Range(0.05, 3600.0));
+  app.add_option("--lease-seconds", lease_seconds,
+                 "a lease not extended this long expires and its task is queued again")
+      ->check(CLI::Range(0.05, 3600.0))
+      ->capture_default_str();
+  double heartbeat_seconds = 1, forget_worker_seconds = 300;
+  app.add_option("--heartbeat-seconds", heartbeat_seconds,
+                 "how often workers heartbeat (at most a third of --lease-seconds)")
+      ->check(CLI::Range(0.01, 600.0))
+      ->capture_default_str();
+  app.add_option("--missed-heartbeats", options.missed_heartbeats,
+                 "a worker silent this many heartbeats (and half one more) is dead: its tasks "
+                 "are queued again at once")
+      ->check(CLI::Range(1u, 100u))
+      ->capture_default_str();
+  app.add_option("--forget-worker-seconds", forget_worker_seconds,
+                 "a dead worker leaves the worker list after this long (0: never)")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
   app.add_option("--tile-size", options.default_tile_size, "default tile side in pixels");
   app.add_option("--passes-per-task", options.default_passes_per_task,
                  "default passes in one task");
@@ -56,12 +72,18 @@ int main(int argc, char** argv) {
   app.add_option("--http-listen", http_listen,
                  "serve /metrics, /healthz, /api and the dashboard on HOST:PORT (PORT or :PORT: "
                  "loopback; off when not given)");
+  bool http_open_metrics = false;
+  app.add_flag("--http-open-metrics", http_open_metrics,
+               "serve /metrics without a token (by default, with --tokens-file, it needs a viewer "
+               "or admin token like the rest of the HTTP side but /healthz)");
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_level(spdlog::level::from_str(log_level));
   spdlog::flush_on(spdlog::level::info);
   options.data_dir = data_dir;
   options.lease_time = std::chrono::milliseconds(int64_t(lease_seconds * 1000));
+  options.heartbeat_interval = std::chrono::milliseconds(int64_t(heartbeat_seconds * 1000));
+  options.forget_worker_after = std::chrono::milliseconds(int64_t(forget_worker_seconds * 1000));
   options.max_scene_bytes = max_scene_mib << 20;
 
   // SIGINT and SIGTERM shut the server down (polled by a thread; the handler only counts).
@@ -100,10 +122,19 @@ int main(int argc, char** argv) {
     spdlog::info("penumbra-coordinator listening on port {} (data in {})", server.port(), data_dir);
     std::unique_ptr<penumbra::farm::HttpFrontend> http;
     if (!http_listen.empty()) {
-      http = std::make_unique<penumbra::farm::HttpFrontend>(
-          coordinator, penumbra::farm::HttpFrontendOptions{.address = http_listen});
-      spdlog::info("penumbra-coordinator HTTP (metrics, dashboard) on {}:{}", http->host(),
-                   http->port());
+      // The same tokens and certificate as the gRPC side (no client certificates: browsers).
+      penumbra::farm::HttpFrontendOptions http_options;
+      http_options.address = http_listen;
+      http_options.batches = &server.batches();
+      http_options.tokens = auth.tokens;
+      http_options.open_metrics = http_open_metrics;
+      http_options.tls_cert = tls.cert;
+      http_options.tls_key = tls.key;
+      http = std::make_unique<penumbra::farm::HttpFrontend>(coordinator, http_options);
+      spdlog::info("penumbra-coordinator HTTP{} (metrics, dashboard) on {}:{}{}",
+                   tls.cert.empty() ? "" : "S", http->host(), http->port(),
+                   auth.tokens ? (http_open_metrics ? " (tokens; /metrics open)" : " (tokens)")
+                               : " (no tokens: open)");
     }
     if (!port_file.empty()) {
       std::string temporary = port_file + ".tmp";

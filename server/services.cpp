@@ -58,12 +58,15 @@ bool is_terminal(v1::JobState state) {
 // changes that arrive during a write), and finishes after writing a final state.
 class WatchReactor final : public grpc::ServerWriteReactor<v1::JobStatus> {
  public:
-  WatchReactor(Coordinator& coordinator, const std::string& job_id)
-      : coordinator_(coordinator), job_id_(job_id), link_(std::make_shared<Link>()) {
+  WatchReactor(Coordinator& coordinator, CallContext caller, const std::string& job_id)
+      : coordinator_(coordinator),
+        caller_(std::move(caller)),
+        job_id_(job_id),
+        link_(std::make_shared<Link>()) {
     link_->reactor = this;
     grpc::Status status = handle([&] {
       std::weak_ptr<Link> link = link_;
-      subscription_ = coordinator_.subscribe(job_id_, [link] {
+      subscription_ = coordinator_.subscribe(caller_, job_id_, [link] {
         if (auto shared = link.lock()) {
           std::lock_guard lock(shared->mutex);
           if (shared->reactor) shared->reactor->on_change_locked();
@@ -123,7 +126,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobStatus> {
 
   void write_locked() {
     dirty_ = false;
-    grpc::Status status = handle([&] { event_ = coordinator_.status(job_id_, false); });
+    grpc::Status status = handle([&] { event_ = coordinator_.status(caller_, job_id_, false); });
     if (!status.ok()) {
       finish_locked(status);
       return;
@@ -140,6 +143,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobStatus> {
   }
 
   Coordinator& coordinator_;
+  CallContext caller_;
   std::string job_id_;
   std::shared_ptr<Link> link_;
   uint64_t subscription_ = 0;
@@ -152,8 +156,8 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobStatus> {
 // FetchResult: the EXR in chunks of 1 MiB, one write at a time.
 class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
  public:
-  FetchReactor(Coordinator& coordinator, const std::string& job_id) {
-    grpc::Status status = handle([&] { exr_ = coordinator.result_exr(job_id); });
+  FetchReactor(Coordinator& coordinator, const CallContext& caller, const std::string& job_id) {
+    grpc::Status status = handle([&] { exr_ = coordinator.result_exr(caller, job_id); });
     if (!status.ok()) {
       Finish(status);
       return;
@@ -187,6 +191,66 @@ class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
   v1::ResultChunk chunk_;
 };
 
+// A client-streaming call refused before it started.
+template <typename Message>
+class RefusedReadReactor final : public grpc::ServerReadReactor<Message> {
+ public:
+  explicit RefusedReadReactor(const grpc::Status& status) { this->Finish(status); }
+  void OnDone() override { delete this; }
+};
+
+// UploadScene: the manifest, then chunks, each checked and stored as it arrives (so a stream
+// cut short keeps what it delivered); at the end of the stream the scene is assembled when
+// complete (server/scene_transfer.h).
+class UploadReactor final : public grpc::ServerReadReactor<v1::SceneUploadMessage> {
+ public:
+  UploadReactor(SceneTransfer& transfer, v1::SceneUploadState* response)
+      : transfer_(transfer), response_(response) {
+    StartRead(&message_);
+  }
+  void OnReadDone(bool ok) override {
+    if (!ok) {
+      // The client closed its side (or the call broke: then Finish is ignored).
+      if (!have_manifest_) {
+        Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                            "the upload stream ended before its manifest"));
+        return;
+      }
+      Finish(handle([&] { *response_ = transfer_.finish(manifest_, chunks_stored_); }));
+      return;
+    }
+    grpc::Status status = handle([&] {
+      if (!have_manifest_) {
+        if (!message_.has_manifest())
+          throw FarmError(FarmErrorCode::InvalidArgument,
+                          "the upload stream's first message must be the manifest");
+        transfer_.check_manifest(message_.manifest());
+        manifest_ = message_.manifest();
+        have_manifest_ = true;
+        return;
+      }
+      if (!message_.has_chunk())
+        throw FarmError(FarmErrorCode::InvalidArgument,
+                        "after the manifest, an upload stream carries only chunks");
+      if (transfer_.put_chunk(manifest_, message_.chunk())) ++chunks_stored_;
+    });
+    if (!status.ok()) {
+      Finish(status);
+      return;
+    }
+    StartRead(&message_);
+  }
+  void OnDone() override { delete this; }
+
+ private:
+  SceneTransfer& transfer_;
+  v1::SceneUploadState* response_;
+  v1::SceneUploadMessage message_;
+  v1::SceneManifest manifest_;
+  bool have_manifest_ = false;
+  uint32_t chunks_stored_ = 0;
+};
+
 }  // namespace
 
 void set_client_limits(const ClientLimits& limits) {
@@ -199,47 +263,49 @@ grpc::ServerUnaryReactor* JobsService::SubmitJob(grpc::CallbackServerContext* co
                                                  v1::SubmitJobResponse* response) {
   return unary(context, [&] {
     // The owner is whoever authenticated (empty with authentication off), never what the
-    // request says.
-    v1::JobSpec spec = request->spec();
-    std::optional<CallAuthorization> authorization = call_authorization(context);
-    spec.set_owner(authorization && authorization->principal ? authorization->principal->name
-                                                             : std::string());
+    // request says: the coordinator sets it from the caller.
+    const CallContext caller = call_context_of(context);
+    const v1::JobSpec& spec = request->spec();
+    const std::string& owner = caller.client;
     ClientLimitsState& state = client_limits_state();
     std::unique_lock lock(state.mutex);
     const size_t max_queued = state.limits.max_queued_jobs_per_owner;
     if (max_queued == 0) {
       lock.unlock();
-      *response = coordinator_.submit(spec);
+      *response = coordinator_.submit(caller, spec);
       return;
     }
     // Counting and submitting under one lock: concurrent submissions of one owner cannot both
     // slip under the limit.
     size_t queued = 0;
     for (const v1::JobStatus& job : coordinator_.list())
-      if (job.owner() == spec.owner() && !is_terminal(job.state())) ++queued;
+      if (job.owner() == owner && !is_terminal(job.state())) ++queued;
     if (queued >= max_queued)
-      throw FarmError(FarmErrorCode::ResourceExhausted,
-                      (spec.owner().empty() ? std::string("anonymous clients")
-                                            : "client \"" + spec.owner() + "\"") +
-                          " already has " + std::to_string(queued) +
-                          " unfinished jobs, the limit per client "
-                          "(--max-queued-jobs-per-client " +
-                          std::to_string(max_queued) + "); wait for one to finish or cancel one");
-    *response = coordinator_.submit(spec);
+      throw FarmError(
+          FarmErrorCode::ResourceExhausted,
+          (owner.empty() ? std::string("anonymous clients") : "client \"" + owner + "\"") +
+              " already has " + std::to_string(queued) +
+              " unfinished jobs, the limit per client "
+              "(--max-queued-jobs-per-client " +
+              std::to_string(max_queued) + "); wait for one to finish or cancel one");
+    *response = coordinator_.submit(caller, spec);
   });
 }
 
 grpc::ServerUnaryReactor* JobsService::GetJob(grpc::CallbackServerContext* context,
                                               const v1::GetJobRequest* request,
                                               v1::JobStatus* response) {
-  return unary(context, [&] { *response = coordinator_.status(request->job_id(), true); });
+  return unary(context, [&] {
+    *response = coordinator_.status(call_context_of(context), request->job_id(), true);
+  });
 }
 
 grpc::ServerUnaryReactor* JobsService::ListJobs(grpc::CallbackServerContext* context,
                                                 const v1::ListJobsRequest*,
                                                 v1::ListJobsResponse* response) {
   return unary(context, [&] {
-    for (v1::JobStatus& job : coordinator_.list()) *response->add_jobs() = std::move(job);
+    for (v1::JobStatus& job : coordinator_.list(call_context_of(context)))
+      *response->add_jobs() = std::move(job);
   });
 }
 
@@ -247,20 +313,22 @@ grpc::ServerWriteReactor<v1::JobStatus>* JobsService::WatchJob(grpc::CallbackSer
                                                                const v1::WatchJobRequest* request) {
   if (std::optional<grpc::Status> refused = refusal(context))
     return new RefusedWriteReactor<v1::JobStatus>(*refused);
-  return new WatchReactor(coordinator_, request->job_id());
+  return new WatchReactor(coordinator_, call_context_of(context), request->job_id());
 }
 
 grpc::ServerUnaryReactor* JobsService::CancelJob(grpc::CallbackServerContext* context,
                                                  const v1::CancelJobRequest* request,
                                                  v1::CancelJobResponse* response) {
-  return unary(context, [&] { response->set_state(coordinator_.cancel(request->job_id())); });
+  return unary(context, [&] {
+    response->set_state(coordinator_.cancel(call_context_of(context), request->job_id()));
+  });
 }
 
 grpc::ServerWriteReactor<v1::ResultChunk>* JobsService::FetchResult(
     grpc::CallbackServerContext* context, const v1::FetchResultRequest* request) {
   if (std::optional<grpc::Status> refused = refusal(context))
     return new RefusedWriteReactor<v1::ResultChunk>(*refused);
-  return new FetchReactor(coordinator_, request->job_id());
+  return new FetchReactor(coordinator_, call_context_of(context), request->job_id());
 }
 
 grpc::ServerUnaryReactor* JobsService::ListWorkers(grpc::CallbackServerContext* context,
@@ -270,6 +338,19 @@ grpc::ServerUnaryReactor* JobsService::ListWorkers(grpc::CallbackServerContext* 
     for (v1::WorkerInfo& worker : coordinator_.workers())
       *response->add_workers() = std::move(worker);
   });
+}
+
+grpc::ServerUnaryReactor* JobsService::StartSceneUpload(grpc::CallbackServerContext* context,
+                                                        const v1::SceneManifest* request,
+                                                        v1::SceneUploadState* response) {
+  return unary(context, [&] { *response = coordinator_.scene_transfer().start(*request); });
+}
+
+grpc::ServerReadReactor<v1::SceneUploadMessage>* JobsService::UploadScene(
+    grpc::CallbackServerContext* context, v1::SceneUploadState* response) {
+  if (std::optional<grpc::Status> refused = refusal(context))
+    return new RefusedReadReactor<v1::SceneUploadMessage>(*refused);
+  return new UploadReactor(coordinator_.scene_transfer(), response);
 }
 
 grpc::ServerUnaryReactor* WorkersService::Register(grpc::CallbackServerContext* context,
@@ -294,6 +375,21 @@ grpc::ServerUnaryReactor* WorkersService::GetScene(grpc::CallbackServerContext* 
                                                    const v1::GetSceneRequest* request,
                                                    v1::ScenePackage* response) {
   return unary(context, [&] { *response = coordinator_.scene(request->scene_hash()); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::GetSceneManifest(grpc::CallbackServerContext* context,
+                                                           const v1::GetSceneRequest* request,
+                                                           v1::SceneManifest* response) {
+  return unary(context,
+               [&] { *response = coordinator_.scene_transfer().manifest(request->scene_hash()); });
+}
+
+grpc::ServerUnaryReactor* WorkersService::GetSceneChunk(grpc::CallbackServerContext* context,
+                                                        const v1::GetSceneChunkRequest* request,
+                                                        v1::SceneChunk* response) {
+  return unary(context, [&] {
+    *response = coordinator_.scene_transfer().chunk(request->scene_hash(), request->index());
+  });
 }
 
 grpc::ServerUnaryReactor* WorkersService::CompleteTask(grpc::CallbackServerContext* context,

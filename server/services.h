@@ -40,6 +40,11 @@ class JobsService final : public v1::Jobs::CallbackService {
   grpc::ServerUnaryReactor* ListWorkers(grpc::CallbackServerContext* context,
                                         const v1::ListWorkersRequest* request,
                                         v1::ListWorkersResponse* response) override;
+  grpc::ServerUnaryReactor* StartSceneUpload(grpc::CallbackServerContext* context,
+                                             const v1::SceneManifest* request,
+                                             v1::SceneUploadState* response) override;
+  grpc::ServerReadReactor<v1::SceneUploadMessage>* UploadScene(
+      grpc::CallbackServerContext* context, v1::SceneUploadState* response) override;
 
  private:
   Coordinator& coordinator_;
@@ -61,6 +66,12 @@ class WorkersService final : public v1::Workers::CallbackService {
   grpc::ServerUnaryReactor* GetScene(grpc::CallbackServerContext* context,
                                      const v1::GetSceneRequest* request,
                                      v1::ScenePackage* response) override;
+  grpc::ServerUnaryReactor* GetSceneManifest(grpc::CallbackServerContext* context,
+                                             const v1::GetSceneRequest* request,
+                                             v1::SceneManifest* response) override;
+  grpc::ServerUnaryReactor* GetSceneChunk(grpc::CallbackServerContext* context,
+                                          const v1::GetSceneChunkRequest* request,
+                                          v1::SceneChunk* response) override;
   grpc::ServerUnaryReactor* CompleteTask(grpc::CallbackServerContext* context,
                                          const v1::CompleteTaskRequest* request,
                                          v1::CompleteTaskResponse* response) override;

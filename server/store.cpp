@@ -16,6 +16,8 @@ namespace {
 
 const char* kSchema = R"sql(
 CREATE TABLE IF NOT EXISTS scenes (hash TEXT PRIMARY KEY, package BLOB NOT NULL);
+CREATE TABLE IF NOT EXISTS scene_chunks (
+  hash TEXT PRIMARY KEY, data BLOB NOT NULL, added_ms INTEGER NOT NULL);
 CREATE TABLE IF NOT EXISTS jobs (
   id INTEGER PRIMARY KEY AUTOINCREMENT, spec BLOB NOT NULL, priority INTEGER NOT NULL,
   state INTEGER NOT NULL, error TEXT NOT NULL, submitted_ms INTEGER NOT NULL,
@@ -231,6 +233,61 @@ std::optional<std::string> Store::scene(const std::string& hash) {
   statement.bind_text(1, hash);
   if (!statement.step()) return std::nullopt;
   return statement.blob(0);
+}
+
+bool Store::has_scene(const std::string& hash) {
+  std::lock_guard lock(mutex_);
+  Statement statement(*this, "SELECT 1 FROM scenes WHERE hash = ?");
+  statement.bind_text(1, hash);
+  return statement.step();
+}
+
+void Store::put_scene_chunk(const std::string& hash, const std::string& data, int64_t unix_ms) {
+  require_space_for_new_work(data.size());
+  std::lock_guard lock(mutex_);
+  Statement(*this, "INSERT OR IGNORE INTO scene_chunks (hash, data, added_ms) VALUES (?, ?, ?)")
+      .bind_text(1, hash)
+      .bind_blob(2, data)
+      .bind(3, unix_ms)
+      .run();
+}
+
+bool Store::has_scene_chunk(const std::string& hash) {
+  std::lock_guard lock(mutex_);
+  Statement statement(*this, "SELECT 1 FROM scene_chunks WHERE hash = ?");
+  statement.bind_text(1, hash);
+  return statement.step();
+}
+
+std::optional<std::string> Store::scene_chunk(const std::string& hash) {
+  std::lock_guard lock(mutex_);
+  Statement statement(*this, "SELECT data FROM scene_chunks WHERE hash = ?");
+  statement.bind_text(1, hash);
+  if (!statement.step()) return std::nullopt;
+  return statement.blob(0);
+}
+
+void Store::put_scene_from_chunks(const std::string& hash, const std::string& package,
+                                  const std::vector<std::string>& chunk_hashes) {
+  require_space_for_new_work(package.size());
+  std::lock_guard lock(mutex_);
+  Transaction transaction(*this);
+  Statement(*this, "INSERT OR IGNORE INTO scenes (hash, package) VALUES (?, ?)")
+      .bind_text(1, hash)
+      .bind_blob(2, package)
+      .run();
+  Statement remove(*this, "DELETE FROM scene_chunks WHERE hash = ?");
+  for (const std::string& chunk : chunk_hashes) {
+    remove.bind_text(1, chunk).run();
+    remove.reset();
+  }
+  transaction.commit();
+}
+
+size_t Store::drop_scene_chunks_before(int64_t unix_ms) {
+  std::lock_guard lock(mutex_);
+  Statement(*this, "DELETE FROM scene_chunks WHERE added_ms < ?").bind(1, unix_ms).run();
+  return size_t(sqlite3_changes(db_));
 }
 
 uint64_t Store::add_job(const JobRecord& job) {
@@ -456,6 +513,26 @@ std::optional<std::string> Store::result(uint64_t job_id) {
   statement.bind(1, int64_t(job_id));
   if (!statement.step() || statement.is_null(0)) return std::nullopt;
   return statement.blob(0);
+}
+
+void Store::cancel_job(const JobRecord& job, const std::optional<std::string>& exr) {
+  std::lock_guard lock(mutex_);
+  write_progress([&] {
+    Transaction transaction(*this);
+    Statement(*this, "UPDATE jobs SET spec = ? WHERE id = ?")
+        .bind_blob(1, job.spec)
+        .bind(2, int64_t(job.id))
+        .run();
+    if (exr)
+      Statement(*this, "UPDATE jobs SET result = ? WHERE id = ?")
+          .bind_blob(1, *exr)
+          .bind(2, int64_t(job.id))
+          .run();
+    Statement(*this, "DELETE FROM task_results WHERE job_id = ?").bind(1, int64_t(job.id)).run();
+    Statement(*this, "DELETE FROM tiles WHERE job_id = ?").bind(1, int64_t(job.id)).run();
+    write_job_fields(job);
+    transaction.commit();
+  });
 }
 
 void Store::drop_work(const JobRecord& job) {

@@ -74,6 +74,19 @@ class Store {
 
   void put_scene(const std::string& hash, const std::string& package);
   std::optional<std::string> scene(const std::string& hash);
+  bool has_scene(const std::string& hash);
+
+  // Chunks of scene uploads in progress, by their SHA-256 (server/scene_transfer.h): kept as they
+  // arrive so an interrupted upload resumes; dropped when their scene is stored, or when older
+  // than a cutoff (uploads abandoned).
+  void put_scene_chunk(const std::string& hash, const std::string& data, int64_t unix_ms);
+  bool has_scene_chunk(const std::string& hash);
+  std::optional<std::string> scene_chunk(const std::string& hash);
+  // Stores the scene and drops the chunks it was assembled from, in one transaction.
+  void put_scene_from_chunks(const std::string& hash, const std::string& package,
+                             const std::vector<std::string>& chunk_hashes);
+  // Drops chunks added before `unix_ms`; returns how many.
+  size_t drop_scene_chunks_before(int64_t unix_ms);
 
   // Inserts the job and returns its id (ids increase with submission order).
   uint64_t add_job(const JobRecord& job);
@@ -103,6 +116,9 @@ class Store {
 
   // Drops what a finished, failed or cancelled job no longer needs (tile sums, task results).
   void drop_work(const JobRecord& job);
+  // A cancelled job: its specification, its fields, its result EXR when given (the sealed
+  // passes) and drop_work, in one transaction.
+  void cancel_job(const JobRecord& job, const std::optional<std::string>& exr);
 
   // True while the reserve file exists (false after a full disk used it up, until remade).
   bool has_reserve();

@@ -61,6 +61,10 @@ BINARIES = {  # installed name -> path in the build folder
     "penumbra-worker": "worker/penumbra-worker",
     "penumbra": "client/penumbra",
 }
+# Modules the binaries open at run time (not DT_NEEDED, so ldd does not show them): file name ->
+# (path in the build folder, ninja target). The binaries look for them in ../lib/penumbra/.
+MODULES = {"libpenumbra_oiio.so": ("lib/libpenumbra_oiio.so", "penumbra_oiio")}
+MODULE_DIR = "/usr/local/lib/penumbra/"
 IMAGE_BINARY = {"penumbra/coordinator": "penumbra-coordinator", "penumbra/worker": "penumbra-worker"}
 BASE_IMAGE_PACKAGES = {"libc6", "libgcc-s1", "libstdc++6"}
 
@@ -85,9 +89,11 @@ class Build:
     def __init__(self, binary_dir):
         self.binary_dir = Path(binary_dir).resolve() if binary_dir else None
         self._flags = {}
+        self._owners = {}
 
     def path(self, name):
-        return self.binary_dir / BINARIES[name] if self.binary_dir else None
+        relative = BINARIES[name] if name in BINARIES else MODULES[name][0]
+        return self.binary_dir / relative if self.binary_dir else None
 
     def flags(self, name):
         if name not in self._flags:
@@ -110,6 +116,22 @@ class Build:
             if flag.startswith("--") and flag not in known:
                 report.add(where, rule, f"{name} has no flag {flag}")
 
+    def owners(self, paths):
+        """The Debian package owning each path that dpkg knows (one dpkg call for all of them:
+        each call reads dpkg's whole database, a third of a second)."""
+        unknown = sorted({p for p in paths if p not in self._owners})
+        if unknown:
+            found = subprocess.run(["dpkg", "-S", *unknown], capture_output=True, text=True)
+            for line in found.stdout.splitlines():
+                if line.startswith("diversion ") or ": " not in line:
+                    continue
+                package, path = line.split(": ", 1)
+                # "pkg:arch" or "pkg1, pkg2" (a path shipped by several): the first package.
+                self._owners[path.strip()] = package.split(",")[0].split(":")[0].strip()
+            for path in unknown:
+                self._owners.setdefault(path, None)
+        return {p: self._owners[p] for p in paths if self._owners.get(p)}
+
     def needed_packages(self, name):
         """Debian packages of the binary's DT_NEEDED libraries (None when unknown)."""
         path = self.path(name)
@@ -122,20 +144,18 @@ class Build:
             match = re.match(r"\s*(\S+) => (\S+)", line)
             if match:
                 resolved[match.group(1)] = match.group(2)
-        packages = {}
+        candidates_of = {}
         for library in needed:
             candidates = []
             if library in resolved:
                 real = os.path.realpath(resolved[library])
                 candidates = [real, resolved[library], real.replace("/usr/lib/", "/lib/", 1),
                               real.replace("/lib/", "/usr/lib/", 1)]
-            package = None
-            for candidate in candidates:
-                found = subprocess.run(["dpkg", "-S", candidate], capture_output=True, text=True)
-                if found.returncode == 0:
-                    package = found.stdout.split(":")[0].strip()
-                    break
-            packages[library] = package
+            candidates_of[library] = candidates
+        owners = self.owners([c for cs in candidates_of.values() for c in cs])
+        packages = {}
+        for library, candidates in candidates_of.items():
+            packages[library] = next((owners[c] for c in candidates if c in owners), None)
         return packages
 
 
@@ -284,6 +304,7 @@ def check_dockerfile(path, source_dir, build, report):
                         match = re.match(r"/src/build/(.+)$", source)
                         if match:
                             target = Path(match.group(1)).name
+                            target = MODULES[target][1] if target in MODULES else target
                             if target not in build_targets.get(options["from"], set()):
                                 report.add(at, "DF-COPY",
                                            f"{source}: stage {options['from']} does not build {target}")
@@ -373,10 +394,16 @@ def check_dockerfile(path, source_dir, build, report):
     for n, instruction, arguments in final_lines:
         if instruction == "WORKDIR" and not arguments.strip().startswith("/"):
             report.add(f"{where}:{n}", "DF-COPY", f"WORKDIR {arguments} is not absolute")
-    # Shared libraries of every Penumbra binary copied into the image.
+    # The modules the binaries open, where they look for them.
+    if any(Path(d).name in BINARIES for d in copied):
+        for module in MODULES:
+            if MODULE_DIR + module not in copied:
+                report.add(where, "DF-MODULE", f"the image does not copy {module} to {MODULE_DIR} "
+                                               "(the binaries open it to read and write images)")
+    # Shared libraries of every Penumbra binary and module copied into the image.
     for destination in copied:
         name = Path(destination).name
-        if name not in BINARIES:
+        if name not in BINARIES and name not in MODULES:
             continue
         packages = build.needed_packages(name)
         if packages is None:

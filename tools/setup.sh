@@ -7,7 +7,7 @@ packages=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libssl-dev
   libspdlog-dev nlohmann-json3-dev libcli11-dev libsqlite3-dev libtinyobjloader-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
-  libplplot-dev plplot-driver-cairo fonts-dejavu-core
+  libplplot-dev plplot-driver-cairo fonts-dejavu-core libpolyclipping-dev
   python3 python3-yaml python3-jsonschema python3-prometheus-client
   chromium iproute2 iptables nftables openssl
   libcpp-httplib-dev python3-kubernetes

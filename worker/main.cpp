@@ -25,6 +25,12 @@ int main(int argc, char** argv) {
                  "host:port of the coordinator (or PENUMBRA_COORDINATOR)");
   app.add_option("--threads", options.threads, "render threads")->check(CLI::Range(1, 1024));
   app.add_option("--cache-dir", options.cache_dir, "folder for scenes cached by content hash");
+  uint64_t cache_max_mib = options.cache_max_bytes >> 20;
+  app.add_option("--cache-max-mib", cache_max_mib,
+                 "bound of the scene cache on disk; beyond it the least recently used scenes are "
+                 "deleted")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 30))
+      ->capture_default_str();
   app.add_option("--name", options.name, "name shown by `penumbra workers`");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error");
   std::string token, token_file;
@@ -39,6 +45,7 @@ int main(int argc, char** argv) {
                  "--token-file or PENUMBRA_TOKEN)");
   app.add_option("--token-file", token_file, "file whose first line is the token");
   CLI11_PARSE(app, argc, argv);
+  options.cache_max_bytes = cache_max_mib << 20;
   spdlog::set_level(spdlog::level::from_str(log_level));
   spdlog::flush_on(spdlog::level::info);
 

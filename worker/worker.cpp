@@ -8,12 +8,14 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "core/render/local_render.h"
 #include "core/sampling/pattern.h"
 #include "penumbra/version.h"
 #include "proto/support/farm_client.h"
+#include "proto/support/scene_chunks.h"
 #include "proto/support/scene_packing.h"
 #include "worker/task_decoding.h"
 
@@ -21,7 +23,9 @@ namespace penumbra::farm {
 
 namespace {
 
-constexpr size_t kMaxRenderers = 4;
+// Renderers are small (a method's estimator, the camera, the pixel filter: the scene's BVHs
+// belong to its prepared scene), so many jobs interleaved on one worker each keep theirs.
+constexpr size_t kMaxRenderers = 64;
 
 std::unique_ptr<grpc::ClientContext> context_with_deadline(std::chrono::seconds seconds) {
   auto context = std::make_unique<grpc::ClientContext>();
@@ -106,7 +110,12 @@ int RenderWorker::run() {
         exit_code = 2;
         break;
       }
-      if (status.ok()) {
+      if (status.error_code() == grpc::StatusCode::ALREADY_EXISTS) {
+        // Our name is held by a live registration: our own previous process (it gets declared
+        // dead after its missed heartbeats) or another worker of the same --name.
+        spdlog::warn("{}; retrying", status.error_message());
+        ok = false;
+      } else if (status.ok()) {
         worker_id_ = response.worker_id();
         heartbeat_period_ = std::chrono::duration<double>(response.heartbeat_seconds());
         last_heartbeat_ = std::chrono::steady_clock::now();
@@ -278,8 +287,9 @@ void RenderWorker::render_loop() {
       // Fields first (the scene hash names a cache file), then against the scene: the tile
       // inside the image, the pass range not empty (worker/task_decoding.h).
       check_task_fields(task);
-      DecodedTask decoded = decode_task(task, *scene_for(task.scene_hash()));
-      std::shared_ptr<const Renderer> renderer = renderer_for(task);
+      std::shared_ptr<const PreparedScene> prepared = prepared_for(task.scene_hash());
+      DecodedTask decoded = decode_task(task, prepared->scene());
+      std::shared_ptr<const Renderer> renderer = renderer_for(task, prepared);
       const TileRect rect = decoded.tile;
       TileAccumulator accumulator(rect);
       // Compute seconds: with one thread the arena runs the task on this thread (its one slot
@@ -320,77 +330,179 @@ void RenderWorker::render_loop() {
   }
 }
 
-std::shared_ptr<const Scene> RenderWorker::scene_for(const std::string& hash) {
-  {
-    std::lock_guard lock(cache_mutex_);
-    auto it = scenes_.find(hash);
-    if (it != scenes_.end()) return it->second;
-  }
-  if (!is_content_hash(hash))
-    throw std::runtime_error("scene hash \"" + hash +
-                             "\" is not a content hash (64 lowercase hex)");
-  v1::ScenePackage package;
-  bool have_package = false;
-  std::filesystem::path cached;
-  if (!options_.cache_dir.empty()) {
-    cached = std::filesystem::path(options_.cache_dir) / "scenes" / (hash + ".pb");
-    std::ifstream in(cached, std::ios::binary);
-    have_package = in && package.ParseFromIstream(&in);
-  }
-  std::optional<Scene> scene;
-  if (have_package) {
-    try {
-      scene = parse_wire_package(package);
-      if (scene->content_hash != hash) scene.reset();
-    } catch (const std::exception& error) {
-      spdlog::warn("cached scene {} unusable ({}); fetching it again", hash, error.what());
-    }
-  }
-  if (!scene) {
+std::string RenderWorker::fetch_scene_bytes(const std::string& hash) {
+  // Transient failures (the coordinator restarting, a deadline under load) are retried with
+  // backoff; anything else fails the task (the coordinator then retries it elsewhere).
+  auto call = [&](const char* what, auto&& invoke) {
     grpc::Status status;
     for (int attempt = 0; attempt < 20; ++attempt) {
-      v1::GetSceneRequest request;
-      request.set_scene_hash(hash);
-      package.Clear();
-      auto context = context_with_deadline(std::chrono::seconds(60));
-      status = stub_->GetScene(context.get(), request, &package);
+      status = invoke();
       if (status.ok() || (status.error_code() != grpc::StatusCode::UNAVAILABLE &&
                           status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED))
         break;
       std::this_thread::sleep_for(std::chrono::milliseconds(100 * (1 << std::min(attempt, 4))));
     }
     if (!status.ok())
-      throw std::runtime_error("cannot fetch scene " + hash + ": " + describe(status));
+      throw std::runtime_error("cannot fetch scene " + hash + " (" + what +
+                               "): " + describe(status));
+  };
+  v1::GetSceneRequest request;
+  request.set_scene_hash(hash);
+  v1::SceneManifest manifest;
+  call("manifest", [&] {
+    auto context = context_with_deadline(std::chrono::seconds(60));
+    return stub_->GetSceneManifest(context.get(), request, &manifest);
+  });
+  if (manifest.scene_hash() != hash)
+    throw std::runtime_error("scene " + hash + ": the coordinator sent the manifest of " +
+                             manifest.scene_hash());
+  check_scene_manifest(manifest, std::numeric_limits<uint64_t>::max());
+  return assemble_scene_chunks(manifest, [&](uint32_t index) {
+    v1::GetSceneChunkRequest chunk_request;
+    chunk_request.set_scene_hash(hash);
+    chunk_request.set_index(index);
+    v1::SceneChunk chunk;
+    call("chunk", [&] {
+      auto context = context_with_deadline(std::chrono::seconds(60));
+      return stub_->GetSceneChunk(context.get(), chunk_request, &chunk);
+    });
+    return std::move(*chunk.mutable_data());
+  });
+}
+
+void RenderWorker::evict_disk_cache(const std::filesystem::path& keep) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  struct Entry {
+    fs::path path;
+    fs::file_time_type used;
+    uintmax_t bytes;
+  };
+  std::vector<Entry> entries;
+  uintmax_t total = 0;
+  for (const fs::directory_entry& entry :
+       fs::directory_iterator(fs::path(options_.cache_dir) / "scenes", error)) {
+    if (entry.path().extension() != ".pb" || !entry.is_regular_file(error)) continue;
+    Entry e{entry.path(), entry.last_write_time(error), entry.file_size(error)};
+    total += e.bytes;
+    entries.push_back(std::move(e));
+  }
+  // Least recently used first (a file's time is touched at each use).
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.used < b.used; });
+  for (const Entry& entry : entries) {
+    if (total <= options_.cache_max_bytes) break;
+    if (entry.path == keep) continue;
+    if (fs::remove(entry.path, error)) {
+      total -= entry.bytes;
+      spdlog::info("scene cache: evicted {} ({} bytes; the cache holds at most {})",
+                   entry.path.filename().string(), entry.bytes, options_.cache_max_bytes);
+    }
+  }
+}
+
+std::shared_ptr<const Scene> RenderWorker::scene_for(const std::string& hash) {
+  if (!is_content_hash(hash))
+    throw std::runtime_error("scene hash \"" + hash +
+                             "\" is not a content hash (64 lowercase hex)");
+  namespace fs = std::filesystem;
+  fs::path cached;
+  std::optional<Scene> scene;
+  if (!options_.cache_dir.empty()) {
+    cached = fs::path(options_.cache_dir) / "scenes" / (hash + ".pb");
+    v1::ScenePackage package;
+    std::ifstream in(cached, std::ios::binary);
+    if (in && package.ParseFromIstream(&in)) {
+      try {
+        scene = parse_wire_package(package);
+        if (scene->content_hash != hash) scene.reset();
+      } catch (const std::exception& error) {
+        spdlog::warn("cached scene {} unusable ({}); fetching it again", hash, error.what());
+      }
+    }
+    if (scene) {
+      std::error_code error;
+      fs::last_write_time(cached, fs::file_time_type::clock::now(), error);  // recently used
+    }
+  }
+  if (!scene) {
+    const std::string bytes = fetch_scene_bytes(hash);
+    v1::ScenePackage package;
+    if (!package.ParseFromString(bytes))
+      throw std::runtime_error("scene " + hash + " arrived unreadable");
     scene = parse_wire_package(package);
     if (scene->content_hash != hash)
       throw std::runtime_error("scene " + hash + " arrived with hash " + scene->content_hash);
     if (!cached.empty()) {
       std::error_code error;
-      std::filesystem::create_directories(cached.parent_path(), error);
+      fs::create_directories(cached.parent_path(), error);
       auto temporary = cached;
       temporary += ".tmp";
       {
         std::ofstream out(temporary, std::ios::binary);
-        package.SerializeToOstream(&out);
+        out.write(bytes.data(), std::streamsize(bytes.size()));
       }
-      std::filesystem::rename(temporary, cached, error);
+      fs::rename(temporary, cached, error);
+      evict_disk_cache(cached);
     }
-    spdlog::info("scene {} ({}) fetched", scene->name, hash.substr(0, 12));
+    spdlog::info("scene {} ({}) fetched: {} bytes", scene->name, hash.substr(0, 12), bytes.size());
   }
-  auto shared = std::make_shared<const Scene>(std::move(*scene));
-  std::lock_guard lock(cache_mutex_);
-  scenes_[hash] = shared;
-  return shared;
+  return std::make_shared<const Scene>(std::move(*scene));
 }
 
-std::shared_ptr<const Renderer> RenderWorker::renderer_for(const v1::Task& task) {
+std::shared_ptr<const PreparedScene> RenderWorker::prepared_for(const std::string& hash) {
+  {
+    std::lock_guard lock(cache_mutex_);
+    for (PreparedEntry& entry : prepared_)
+      if (entry.scene_hash == hash) {
+        entry.last_use = ++use_clock_;
+        return entry.prepared;
+      }
+  }
+  // Parsing and building the BVHs take a while (seconds for a million triangles): outside the
+  // lock. One render thread asks, so a scene is prepared once.
+  auto prepared = std::make_shared<const PreparedScene>(scene_for(hash));
+  std::lock_guard lock(cache_mutex_);
+  prepared_.push_back({hash, prepared, ++use_clock_});
+  evict_prepared_locked(hash);
+  return prepared;
+}
+
+void RenderWorker::evict_prepared_locked(const std::string& keep) {
+  // Sizes are read now: a line-query BVH built since a scene was cached counts too.
+  auto total = [this] {
+    size_t bytes = 0;
+    for (const PreparedEntry& entry : prepared_) bytes += entry.prepared->memory_bytes();
+    return bytes;
+  };
+  while (prepared_.size() > 1 && total() > options_.max_prepared_bytes) {
+    auto oldest = prepared_.end();
+    for (auto it = prepared_.begin(); it != prepared_.end(); ++it)
+      if (it->scene_hash != keep && (oldest == prepared_.end() || it->last_use < oldest->last_use))
+        oldest = it;
+    if (oldest == prepared_.end()) break;
+    spdlog::info("prepared scene {} evicted ({} MiB; prepared scenes are held up to {} MiB)",
+                 oldest->scene_hash.substr(0, 12), oldest->prepared->memory_bytes() >> 20,
+                 options_.max_prepared_bytes >> 20);
+    // Its renderers hold it too: they go with it, so the memory is freed.
+    std::erase_if(renderers_,
+                  [&](const auto& item) { return item.second.scene_hash == oldest->scene_hash; });
+    prepared_.erase(oldest);
+  }
+}
+
+std::shared_ptr<const Renderer> RenderWorker::renderer_for(
+    const v1::Task& task, const std::shared_ptr<const PreparedScene>& prepared) {
   std::ostringstream key;
   key << task.job_id() << '|' << task.scene_hash() << '|' << task.method() << '|' << task.sampler()
       << '|' << task.seed();
   {
     std::lock_guard lock(cache_mutex_);
     auto it = renderers_.find(key.str());
-    if (it != renderers_.end()) return it->second;
+    if (it != renderers_.end()) {
+      it->second.last_use = ++use_clock_;
+      return it->second.renderer;
+    }
   }
   RenderOptions render_options;
   render_options.method = task.method();
@@ -398,13 +510,15 @@ std::shared_ptr<const Renderer> RenderWorker::renderer_for(const v1::Task& task)
   if (!pattern) throw std::runtime_error("unknown sampler \"" + task.sampler() + "\"");
   render_options.sampler = *pattern;
   render_options.seed = task.seed();
-  auto renderer = std::make_shared<const Renderer>(scene_for(task.scene_hash()), render_options);
+  // Only the method's estimator is new; the scene's BVHs and textures are the prepared scene's.
+  auto renderer = std::make_shared<const Renderer>(prepared, render_options);
   std::lock_guard lock(cache_mutex_);
-  renderers_[key.str()] = renderer;
-  renderer_order_.push_back(key.str());
-  while (renderer_order_.size() > kMaxRenderers) {
-    renderers_.erase(renderer_order_.front());
-    renderer_order_.pop_front();
+  renderers_[key.str()] = {task.scene_hash(), renderer, ++use_clock_};
+  if (renderers_.size() > kMaxRenderers) {
+    auto oldest = renderers_.begin();
+    for (auto it = renderers_.begin(); it != renderers_.end(); ++it)
+      if (it->second.last_use < oldest->second.last_use) oldest = it;
+    renderers_.erase(oldest);
   }
   return renderer;
 }

@@ -2,15 +2,22 @@
 // The worker daemon's core: registers with the coordinator, leases as many tasks as it has
 // threads (so one is always waiting while another renders), renders them with core in a TBB
 // arena of `threads`, heartbeats its leases, and delivers results, keeping those it could not
-// deliver and retrying them. Scenes are fetched by content hash and cached on disk and in memory;
-// a job's Renderer is kept across its tiles. When the coordinator is away it retries with
-// backoff (it may start before the coordinator). drain() stops leasing, finishes what it holds,
-// delivers it and returns from run().
+// deliver and retrying them. When the coordinator is away it retries with backoff (it may start
+// before the coordinator). drain() stops leasing, finishes what it holds, delivers it and
+// returns from run().
+//
+// Scenes are fetched by content hash in chunks (GetSceneManifest, then GetSceneChunk per chunk,
+// each checked against its SHA-256) and cached on disk (cache_dir, at most cache_max_bytes,
+// least recently used scenes deleted first). A scene is prepared once (parsed, Embree and
+// line-query BVHs built, textures decoded: core/render/prepared_scene.h) and shared by every
+// job of it whatever its method, within max_prepared_bytes of memory; a job's Renderer (its
+// method's estimator) is kept across its tiles.
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -19,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/render/prepared_scene.h"
 #include "core/render/renderer.h"
 #include "penumbra/v1/farm.grpc.pb.h"
 
@@ -31,6 +39,11 @@ struct WorkerOptions {
   std::string token;                      // "worker" or "admin" role; empty: none
   int threads = 1;
   std::string cache_dir;  // empty: scenes are cached in memory only
+  // The disk cache's bound: beyond it, the scenes used least recently are deleted.
+  uint64_t cache_max_bytes = uint64_t(4) << 30;
+  // Memory for prepared scenes (parsed scene, Embree and line-query BVHs, textures) kept across
+  // jobs; the scene in use is kept even when it alone is larger.
+  size_t max_prepared_bytes = size_t(4) << 30;
   std::string name = "worker";
   std::string build_flavour;  // empty: penumbra::kBuildFlavour
   std::chrono::milliseconds idle_poll{100};
@@ -73,7 +86,17 @@ class RenderWorker {
   void render_loop();
   void render(const v1::Task& task);
   std::shared_ptr<const Scene> scene_for(const std::string& hash);
-  std::shared_ptr<const Renderer> renderer_for(const v1::Task& task);
+  // The package's bytes from the coordinator, in chunks, each checked against the manifest.
+  std::string fetch_scene_bytes(const std::string& hash);
+  // Deletes the least recently used scene files until the cache fits cache_max_bytes (`keep`,
+  // the scene just written, stays).
+  void evict_disk_cache(const std::filesystem::path& keep);
+  // The scene parsed and prepared (BVHs, textures), shared by every job of it whatever the
+  // method; kept by content hash within max_prepared_bytes, least recently used evicted first.
+  std::shared_ptr<const PreparedScene> prepared_for(const std::string& hash);
+  void evict_prepared_locked(const std::string& keep);
+  std::shared_ptr<const Renderer> renderer_for(
+      const v1::Task& task, const std::shared_ptr<const PreparedScene>& prepared);
   void backoff();
   void reset_backoff() { backoff_ = std::chrono::milliseconds(0); }
 
@@ -95,9 +118,19 @@ class RenderWorker {
   std::thread render_thread_;
 
   std::mutex cache_mutex_;
-  std::map<std::string, std::shared_ptr<const Scene>> scenes_;
-  std::map<std::string, std::shared_ptr<const Renderer>> renderers_;  // by job and options
-  std::deque<std::string> renderer_order_;
+  uint64_t use_clock_ = 0;  // orders uses, for least-recently-used eviction
+  struct PreparedEntry {
+    std::string scene_hash;
+    std::shared_ptr<const PreparedScene> prepared;
+    uint64_t last_use = 0;
+  };
+  std::vector<PreparedEntry> prepared_;
+  struct RendererEntry {
+    std::string scene_hash;
+    std::shared_ptr<const Renderer> renderer;
+    uint64_t last_use = 0;
+  };
+  std::map<std::string, RendererEntry> renderers_;  // by job and options
 };
 
 }  // namespace penumbra::farm

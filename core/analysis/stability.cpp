@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/analysis/mean_consistency.h"
 #include "core/math/lambert_polygon.h"
 #include "core/method/method.h"
 #include "core/render/shading.h"
@@ -364,6 +365,7 @@ StabilityTable run_stability(const StabilityOptions& options) {
 
   // References: the closed form, or a converged bsdf+sa estimate with its standard error.
   std::vector<double> reference(table.cases.size()), reference_error(table.cases.size());
+  std::vector<int> reference_trials(table.cases.size(), 0);  // 0: exact
   for (size_t i = 0; i < table.cases.size(); ++i) {
     const StabilityCase& c = table.cases[i];
     if (c.closed_form) {
@@ -376,6 +378,7 @@ StabilityTable run_stability(const StabilityOptions& options) {
       if (m.nonfinite) throw std::runtime_error("the reference for " + c.name + " is not finite");
       reference[i] = m.mean();
       reference_error[i] = m.standard_error();
+      reference_trials[i] = int(m.count);
       table.reference_kind.push_back(
           "bsdf+sa, " +
           std::to_string(uint64_t(options.reference_trials) * uint64_t(options.reference_samples)) +
@@ -416,9 +419,16 @@ StabilityTable run_stability(const StabilityOptions& options) {
       // of an edge-on light is zero, not noise).
       if (scale == 0)
         cell.consistent = std::abs(cell.mean) <= 1e-12 && cell.nonfinite == 0;
+      else if (m.count < 2)
+        cell.consistent = false;
       else
-        cell.consistent =
-            cell.nonfinite == 0 && (cell.bias_sigmas <= 5 || std::abs(cell.relative_bias) <= 1e-3);
+        // Welch's t at the false-alarm rate of a 5-sigma normal test, whatever the trial count
+        // (core/analysis/mean_consistency.h): with few trials the standard errors are noisy.
+        cell.consistent = cell.nonfinite == 0 &&
+                          (mean_consistency(cell.mean, cell.standard_error, int(m.count),
+                                            cell.reference, reference_error[i], reference_trials[i])
+                               .consistent ||
+                           std::abs(cell.relative_bias) <= 1e-3);
       table.cells.push_back(cell);
     }
   }
@@ -453,8 +463,9 @@ std::string stability_markdown(const StabilityTable& table) {
   }
   out << "\nCells: relative bias of the mean of the estimates against the reference. `~`: the "
          "method is unbiased but cannot converge here at any practical budget (listed in "
-         "core/analysis/stability.cpp); `!`: inconsistent with the reference (more than 5 "
-         "standard errors and 0.1%); `NaN:k`: k non-finite estimates.\n";
+         "core/analysis/stability.cpp); `!`: inconsistent with the reference (Welch's t test at "
+         "the false-alarm rate of 5 standard errors, its threshold growing as the trials get "
+         "fewer, and more than 0.1%); `NaN:k`: k non-finite estimates.\n";
   out << "\nReferences: ";
   for (size_t i = 0; i < table.cases.size(); ++i)
     out << (i ? "; " : "") << table.cases[i].name << ": " << table.reference_kind[i];

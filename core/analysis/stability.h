@@ -53,8 +53,10 @@ struct StabilityCell {
   double relative_bias = 0;   // (mean - reference) / reference; 0 when both are 0
   double bias_sigmas = 0;     // |mean - reference| / combined standard error
   double relative_std = 0;    // std. dev. of one estimate / reference
-  // Unbiased within the test's tolerance: |bias| <= 5 standard errors, or |relative bias| <=
-  // 1e-3 (the reference's own error for converged references).
+  // Unbiased within the test's tolerance: Welch's t test of the mean against the reference at
+  // the false-alarm rate of a 5-standard-error normal test (core/analysis/mean_consistency.h:
+  // 5 standard errors for many trials, more for few), or |relative bias| <= 1e-3 (the
+  // reference's own error for converged references).
   bool consistent = true;
   // Set when the method is unbiased but cannot converge at any practical budget in this case
   // (e.g. BSDF sampling of a 1 mm light 40 m away): the reason, shown as "~" in the table.

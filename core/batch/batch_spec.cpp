@@ -36,7 +36,7 @@ class BatchSpecParser {
     root.expect_object();
     check_format(root.required("format"));
     root.collect_unknown_keys({"format", "name", "description", "scene", "methods", "budget",
-                               "reference", "regions", "seed", "repeats"},
+                               "reference", "regions", "seed", "repeats", "baseline", "strict"},
                               spec_.warnings);
     if (auto name = root.optional("name")) {
       spec_.name = text_value(*name, "name");
@@ -57,12 +57,25 @@ class BatchSpecParser {
         seed->fail("the seed must be a non-negative integer, got " + seed->quoted_value());
       spec_.seed = uint64_t(value);
     }
+    if (auto baseline = root.optional("baseline")) {
+      spec_.baseline = text_value(*baseline, "the baseline");
+      bool known = false;
+      for (const BatchMethodSpec& method : spec_.methods)
+        known = known || method.label == spec_.baseline;
+      if (!known)
+        baseline->fail("the baseline \"" + spec_.baseline + "\" is not the label of a method");
+    }
     if (auto repeats = root.optional("repeats")) {
       int64_t value = repeats->integer();
       if (value < 1 || value > int64_t(limits_.max_repeats))
         repeats->fail("repeats must be an integer in [1, " + std::to_string(limits_.max_repeats) +
                       "] (limit max_repeats), got " + repeats->quoted_value());
       spec_.repeats = uint32_t(value);
+    }
+    if (auto strict = root.optional("strict")) {
+      if (!strict->value().is_boolean())
+        strict->fail("strict must be true or false, got " + strict->quoted_value());
+      spec_.strict = strict->value().get<bool>();
     }
     return std::move(spec_);
   }
@@ -207,7 +220,16 @@ class BatchSpecParser {
           "the reference must be \"auto\", \"job:<id>\", the path of an EXR file or an "
           "object {\"method\", \"sampler\", \"spp\", \"seed\"}, got " +
           node.quoted_value());
-    node.collect_unknown_keys({"method", "sampler", "spp", "seed"}, spec_.warnings);
+    if (auto kind = node.optional("kind")) {
+      const std::string text = text_value(*kind, "the reference kind");
+      if (text == "exact") {
+        parse_exact_reference(node);
+        return;
+      }
+      if (text != "auto")
+        kind->fail("the reference kind must be \"auto\" or \"exact\", got " + kind->quoted_value());
+    }
+    node.collect_unknown_keys({"kind", "method", "sampler", "spp", "seed"}, spec_.warnings);
     reference.kind = BatchReferenceKind::Auto;
     if (auto method = node.optional("method")) {
       reference.method = text_value(*method, "the method");
@@ -219,6 +241,28 @@ class BatchSpecParser {
         sampler->fail("unknown sampler '" + reference.sampler + "'");
     }
     if (auto spp = node.optional("spp")) reference.spp = spp_value(*spp);
+    if (auto seed = node.optional("seed")) {
+      int64_t value = seed->integer();
+      if (value < 0)
+        seed->fail("the seed must be a non-negative integer, got " + seed->quoted_value());
+      reference.seed = uint64_t(value);
+    }
+  }
+
+  void parse_exact_reference(const JsonNode& node) {
+    BatchReferenceSpec& reference = spec_.reference;
+    node.collect_unknown_keys({"kind", "camera_samples", "fallback", "fallback_samples", "seed"},
+                              spec_.warnings);
+    reference.kind = BatchReferenceKind::Exact;
+    reference.exr_path = "(the exact reference the client renders)";
+    if (auto samples = node.optional("camera_samples"))
+      reference.camera_samples = spp_value(*samples);
+    if (auto fallback = node.optional("fallback")) {
+      reference.fallback_method = text_value(*fallback, "the fallback method");
+      check_method(*fallback, reference.fallback_method);
+    }
+    if (auto samples = node.optional("fallback_samples"))
+      reference.fallback_samples = spp_value(*samples);
     if (auto seed = node.optional("seed")) {
       int64_t value = seed->integer();
       if (value < 0)

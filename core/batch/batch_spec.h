@@ -8,7 +8,8 @@
 //   {"format": "penumbra/batch@1", "name": "fig1-monoliths", "scene": "monoliths",
 //    "methods": [{"method": "line-sa:v", "sampler": "stratified", "label": "ours"}, "sa"],
 //    "budget": {"seconds": 10, "spp": [16, 64]},
-//    "reference": "auto",  // or "job:job-7", "path/to/ref.exr", {"method":..,"spp":..}
+//    "reference": "auto",  // or "job:job-7", "path/to/ref.exr", {"method":..,"spp":..},
+//                          // {"kind": "exact", "camera_samples": 16}
 //    "regions": {"penumbra": [120, 300, 220, 400]}, "seed": 1, "repeats": 3}
 
 #include <cstddef>
@@ -49,6 +50,10 @@ enum class BatchReferenceKind {
   Auto,  // rendered by the farm with a robust method at high spp, cached by scene and settings
   Exr,   // an EXR file the client uploads
   Job,   // the result of a finished job on the same coordinator
+  // Closed-form direct illumination per camera sample (core/exact), rendered by the client
+  // (cached by scene hash, build flavour and settings) and uploaded like an EXR; pixels without
+  // a closed form fall back to a converged estimate.
+  Exact,
 };
 
 struct BatchReferenceSpec {
@@ -60,6 +65,11 @@ struct BatchReferenceSpec {
   std::string sampler = "stratified";
   uint32_t spp = 1024;
   uint64_t seed = 0x5eed;
+  // Exact: camera rays per pixel, and the fallback where no closed form applies (method, and
+  // samples per term for each camera sample).
+  uint32_t camera_samples = 16;
+  std::string fallback_method = "bsdf+sa";
+  uint32_t fallback_samples = 64;
 };
 
 struct BatchSpec {
@@ -71,7 +81,11 @@ struct BatchSpec {
   BatchReferenceSpec reference;
   std::map<std::string, Region> regions;  // merged with the scene's ("image" is reserved)
   uint64_t seed = 1;                      // repeat r renders with seed + r
-  uint32_t repeats = 1;
+  uint32_t repeats = 3;                   // independent repeats (intervals need two or more)
+  std::string baseline;  // the label efficiencies are relative to (empty: the first method)
+  // "strict": true refuses a scene whose reader warns (unknown keys, ignored parameters); by
+  // default the warnings are printed and carried in every run's status and EXR.
+  bool strict = false;
   // Unknown keys the reader ignored (forward compatibility), each as "JSON path: note".
   std::vector<std::string> warnings;
 };

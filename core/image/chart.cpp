@@ -192,6 +192,12 @@ LineFit fit_line(const ChartSeries& series, bool log_x, bool log_y) {
   return fit;
 }
 
+std::pair<double, double> log_axis_range(double low, double high) {
+  if (std::floor(high) - std::ceil(low) >= 1) return {low, high};
+  const double snapped_low = std::floor(low);
+  return {snapped_low, std::max(std::ceil(high), snapped_low + 1)};
+}
+
 void write_line_chart(const std::string& path, const ChartSpec& spec) {
   const char* device = device_for(path);
   if (spec.width < 16 || spec.height < 16 || spec.width > 16384 || spec.height > 16384)
@@ -214,6 +220,13 @@ void write_line_chart(const std::string& path, const ChartSpec& spec) {
     throw std::invalid_argument("chart '" + path + "': no point to draw (" +
                                 std::to_string(spec.series.size()) + " series)");
   Range x_axis = x_range.padded(spec.log_x), y_axis = y_range.padded(spec.log_y);
+  auto two_decades = [](Range& axis) {
+    auto [low, high] = log_axis_range(axis.low, axis.high);
+    axis.low = low;
+    axis.high = high;
+  };
+  if (spec.log_x) two_decades(x_axis);
+  if (spec.log_y) two_decades(y_axis);
 
   // Make sure the file can be written: PLplot would end the process if it cannot.
   {

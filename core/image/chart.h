@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace penumbra {
@@ -39,6 +40,11 @@ struct ChartSpec {
 // Least-squares line through a series' points in plotted coordinates (points that a log axis
 // cannot show are skipped). Throws std::invalid_argument with fewer than 2 usable points.
 LineFit fit_line(const ChartSeries& series, bool log_x, bool log_y);
+
+// The drawn range of a logarithmic axis whose padded data range is [low, high] in log10: PLplot
+// labels such an axis at its decades only, so a range holding fewer than two decades is widened
+// to the decades around it (every log axis gets at least two labels).
+std::pair<double, double> log_axis_range(double low, double high);
 
 // Writes the chart to `path` (".svg" or ".png"). Points a logarithmic axis cannot show (<= 0)
 // and non-finite values are left out. Thread-safe (PLplot keeps global state; calls are

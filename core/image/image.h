@@ -51,7 +51,10 @@ Image read_exr(const std::string& path, ImageMetadata* metadata = nullptr,
                Image* variance = nullptr);
 Image decode_exr(const std::string& bytes, ImageMetadata* metadata = nullptr,
                  Image* variance = nullptr);
-// Tone-mapped 8-bit sRGB preview (exposure scale, then clamp and the sRGB curve).
+// Tone-mapped 8-bit sRGB preview (exposure scale, then clamp and the sRGB curve; non-finite
+// pixels black) as PNG bytes: the one preview encoder of the CLI and the coordinator's HTTP side.
+std::string encode_png_preview(const Image& color, double exposure = 1.0);
+// The same bytes written atomically to `path`.
 void write_png_preview(const std::string& path, const Image& color, double exposure = 1.0);
 
 }  // namespace penumbra

@@ -1,13 +1,10 @@
-// EXR and PNG I/O through OpenImageIO 2.4.
+// EXR and PNG I/O through OpenImageIO 2.4, in the module of core/image/oiio_services.h.
 //
 // Precision: pixels are float in memory. EXR channels are written as float (bit-exact round
 // trip) or half (half the bytes, ~3 decimal digits) as the caller asks; every channel of one file
-// has the same type. In-memory encoding uses OIIO's IOVecOutput / IOMemReader proxies: the
-// OpenEXR plugin of OIIO 2.4 supports them, so encode/decode never touch the disk. write_exr
-// encodes in memory too, then writes the file atomically (temporary file + rename).
+// has the same type. Encoding and decoding happen in memory; write_exr encodes in memory too, then
+// writes the file atomically (temporary file + rename).
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,12 +23,11 @@
 #include <vector>
 
 #include "core/image/image.h"
+#include "core/image/oiio_services.h"
 
 namespace penumbra {
 
 namespace {
-
-namespace oiio = OIIO;
 
 constexpr std::string_view kMetadataPrefix = "penumbra:";
 // Largest image read: the scene format's resolution limit per side, and far more channels than
@@ -59,14 +55,10 @@ void check_image_shape(const Image& image, const std::string& what, const std::s
                              std::to_string(size_t(image.width) * image.height * 3));
 }
 
-// The spec and the interleaved float pixels of an EXR with R,G,B and optionally variance.R/G/B.
-struct ExrContents {
-  oiio::ImageSpec spec;
-  std::vector<float> pixels;
-};
-
-ExrContents exr_contents(const Image& color, const Image* variance, const ImageMetadata& metadata,
-                         ExrPixelType pixel_type, const std::string& where) {
+// The interleaved float pixels of an EXR with R,G,B and optionally variance.R/G/B, and its
+// metadata as string attributes.
+oiio::Pixels exr_contents(const Image& color, const Image* variance, const ImageMetadata& metadata,
+                          const std::string& where) {
   // Check the images.
   check_image_shape(color, "color", where);
   if (variance) {
@@ -79,24 +71,21 @@ ExrContents exr_contents(const Image& color, const Image* variance, const ImageM
 
   // Describe the channels and the metadata.
   int channel_count = variance ? 6 : 3;
-  oiio::TypeDesc format =
-      pixel_type == ExrPixelType::Half ? oiio::TypeDesc::HALF : oiio::TypeDesc::FLOAT;
-  ExrContents contents;
-  contents.spec = oiio::ImageSpec(color.width, color.height, channel_count, format);
-  contents.spec.channelnames.clear();
-  for (const char* name : kColorChannels) contents.spec.channelnames.emplace_back(name);
+  oiio::Pixels contents;
+  contents.width = color.width;
+  contents.height = color.height;
+  contents.channels = channel_count;
+  for (const char* name : kColorChannels) contents.channel_names.emplace_back(name);
   if (variance)
-    for (const char* name : kVarianceChannels) contents.spec.channelnames.emplace_back(name);
-  contents.spec.alpha_channel = -1;
-  contents.spec.attribute("compression", "zip");
+    for (const char* name : kVarianceChannels) contents.channel_names.emplace_back(name);
   for (const auto& [key, value] : metadata)
-    contents.spec.attribute(metadata_attribute_name(key), value);
+    contents.strings.emplace_back(metadata_attribute_name(key), value);
 
   // Interleave the pixels.
   size_t pixel_count = size_t(color.width) * size_t(color.height);
-  contents.pixels.resize(pixel_count * channel_count);
+  contents.data.resize(pixel_count * channel_count);
   for (size_t p = 0; p < pixel_count; ++p) {
-    float* out = &contents.pixels[p * channel_count];
+    float* out = &contents.data[p * channel_count];
     for (int c = 0; c < 3; ++c) out[c] = color.rgb[p * 3 + c];
     if (variance)
       for (int c = 0; c < 3; ++c) out[3 + c] = variance->rgb[p * 3 + c];
@@ -104,84 +93,67 @@ ExrContents exr_contents(const Image& color, const Image* variance, const ImageM
   return contents;
 }
 
-void write_contents(oiio::ImageOutput& output, const std::string& name, const ExrContents& contents,
-                    const std::string& where) {
-  if (!output.open(name, contents.spec))
-    throw std::runtime_error(where + ": cannot open for writing: " + output.geterror());
-  if (!output.write_image(oiio::TypeDesc::FLOAT, contents.pixels.data())) {
-    std::string error = output.geterror();
-    output.close();
-    throw std::runtime_error(where + ": cannot write pixels: " + error);
-  }
-  if (!output.close())
-    throw std::runtime_error(where + ": cannot finish the file: " + output.geterror());
-}
-
-int find_channel(const oiio::ImageSpec& spec, std::string_view name) {
-  for (size_t i = 0; i < spec.channelnames.size(); ++i)
-    if (spec.channelnames[i] == name) return int(i);
+int find_channel(const oiio::Pixels& image, std::string_view name) {
+  for (size_t i = 0; i < image.channel_names.size(); ++i)
+    if (image.channel_names[i] == name) return int(i);
   return -1;
 }
 
-// Reads an opened EXR: R,G,B by name (any channel order), variance.R/G/B when asked and present,
-// and every "penumbra:" string attribute.
-Image read_contents(oiio::ImageInput& input, const std::string& where, ImageMetadata* metadata,
-                    Image* variance) {
-  const oiio::ImageSpec& spec = input.spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1)
-    throw std::runtime_error(where + ": unsupported image size " + std::to_string(spec.width) +
-                             "x" + std::to_string(spec.height) + "x" + std::to_string(spec.depth));
-  // A corrupt or hostile header must not make us allocate terabytes.
-  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || spec.nchannels > kMaxChannels)
-    throw std::runtime_error(where + ": image of " + std::to_string(spec.width) + "x" +
-                             std::to_string(spec.height) + " pixels and " +
-                             std::to_string(spec.nchannels) + " channels exceeds the limits (" +
-                             std::to_string(kMaxImageSide) + " per side, " +
-                             std::to_string(kMaxChannels) + " channels)");
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ",") + name;
+  return out;
+}
 
+// R,G,B by name (any channel order), variance.R/G/B when asked and present, and every
+// "penumbra:" string attribute of a read EXR.
+Image image_of(const oiio::Pixels& pixels, const std::string& where, ImageMetadata* metadata,
+               Image* variance) {
   // Find the channels.
   int color_index[3], variance_index[3];
   for (int c = 0; c < 3; ++c) {
-    color_index[c] = find_channel(spec, kColorChannels[c]);
+    color_index[c] = find_channel(pixels, kColorChannels[c]);
     if (color_index[c] < 0)
       throw std::runtime_error(where + ": no channel " + kColorChannels[c] +
-                               " (channels: " + oiio::Strutil::join(spec.channelnames, ",") + ")");
-    variance_index[c] = find_channel(spec, kVarianceChannels[c]);
+                               " (channels: " + joined(pixels.channel_names) + ")");
+    variance_index[c] = find_channel(pixels, kVarianceChannels[c]);
   }
   bool has_variance = variance_index[0] >= 0 && variance_index[1] >= 0 && variance_index[2] >= 0;
 
-  // Read every channel as float.
-  size_t pixel_count = size_t(spec.width) * size_t(spec.height);
-  size_t channel_count = size_t(spec.nchannels);
-  std::vector<float> pixels(pixel_count * channel_count);
-  if (!input.read_image(0, 0, 0, spec.nchannels, oiio::TypeDesc::FLOAT, pixels.data()))
-    throw std::runtime_error(where + ": cannot read pixels: " + input.geterror());
-
   // De-interleave.
-  Image color(spec.width, spec.height);
+  size_t pixel_count = size_t(pixels.width) * size_t(pixels.height);
+  size_t channel_count = size_t(pixels.channels);
+  Image color(pixels.width, pixels.height);
   for (size_t p = 0; p < pixel_count; ++p)
-    for (int c = 0; c < 3; ++c) color.rgb[p * 3 + c] = pixels[p * channel_count + color_index[c]];
+    for (int c = 0; c < 3; ++c)
+      color.rgb[p * 3 + c] = pixels.data[p * channel_count + color_index[c]];
   if (variance) {
     *variance = Image();
     if (has_variance) {
-      *variance = Image(spec.width, spec.height);
+      *variance = Image(pixels.width, pixels.height);
       for (size_t p = 0; p < pixel_count; ++p)
         for (int c = 0; c < 3; ++c)
-          variance->rgb[p * 3 + c] = pixels[p * channel_count + variance_index[c]];
+          variance->rgb[p * 3 + c] = pixels.data[p * channel_count + variance_index[c]];
     }
   }
 
   // Collect the metadata.
   if (metadata) {
     metadata->clear();
-    for (const oiio::ParamValue& attribute : spec.extra_attribs) {
-      std::string name = attribute.name().string();
-      if (name.compare(0, kMetadataPrefix.size(), kMetadataPrefix) != 0) continue;
-      if (attribute.type() != oiio::TypeDesc::STRING) continue;
-      (*metadata)[name] = attribute.get_string();
-    }
+    for (const auto& [name, value] : pixels.strings)
+      if (name.compare(0, kMetadataPrefix.size(), kMetadataPrefix) == 0) (*metadata)[name] = value;
   }
   return color;
+}
+
+// Runs an operation of the image module, naming `where` in its errors.
+template <typename F>
+auto in_module(const std::string& where, F&& operation) {
+  try {
+    return operation(oiio::services());
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(where + ": " + error.what());
+  }
 }
 
 // sRGB transfer curve (IEC 61966-2-1) of a linear value in [0,1].
@@ -197,15 +169,10 @@ namespace {
 // Encodes to memory; `where` names the destination in errors.
 std::string encode_exr_for(const std::string& where, const Image& color, const Image* variance,
                            const ImageMetadata& metadata, ExrPixelType pixel_type) {
-  ExrContents contents = exr_contents(color, variance, metadata, pixel_type, where);
-  std::vector<unsigned char> bytes;
-  oiio::Filesystem::IOVecOutput proxy(bytes);
-  auto output = oiio::ImageOutput::create("openexr", &proxy);
-  if (!output) throw std::runtime_error(where + ": no OpenEXR writer: " + oiio::geterror());
-  if (!output->supports("ioproxy"))
-    throw std::runtime_error(where + ": this OpenImageIO's OpenEXR writer cannot write to memory");
-  write_contents(*output, "memory.exr", contents, where);
-  return std::string(bytes.begin(), bytes.end());
+  oiio::Pixels contents = exr_contents(color, variance, metadata, where);
+  return in_module(where, [&](const oiio::Services& services) {
+    return services.encode_exr(contents, pixel_type == ExrPixelType::Half);
+  });
 }
 
 // Writes the bytes to a temporary file beside `path`, then renames it over `path`: a reader (or a
@@ -250,17 +217,10 @@ std::string encode_exr(const Image& color, const Image* variance, const ImageMet
 
 Image read_exr(const std::string& path, ImageMetadata* metadata, Image* variance) {
   std::string where = "EXR '" + path + "'";
-  auto input = oiio::ImageInput::create("openexr");
-  if (!input) throw std::runtime_error(where + ": no OpenEXR reader: " + oiio::geterror());
-  oiio::ImageSpec spec;
-  if (!input->open(path, spec)) {
-    std::string error = input->geterror();
-    throw std::runtime_error(where + ": cannot open: " +
-                             (error.empty() ? std::string("not a readable EXR file") : error));
-  }
-  Image color = read_contents(*input, where, metadata, variance);
-  input->close();
-  return color;
+  oiio::Pixels pixels = in_module(where, [&](const oiio::Services& services) {
+    return services.read_exr(path, /*from_memory=*/false, kMaxImageSide, kMaxChannels);
+  });
+  return image_of(pixels, where, metadata, variance);
 }
 
 Image decode_exr(const std::string& bytes, ImageMetadata* metadata, Image* variance) {
@@ -272,24 +232,15 @@ Image decode_exr(const std::string& bytes, ImageMetadata* metadata, Image* varia
       !std::equal(kExrMagic, kExrMagic + 4, reinterpret_cast<const unsigned char*>(bytes.data())))
     throw std::runtime_error(where + ": not an OpenEXR image (bad magic number)");
 
-  oiio::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
-  auto input = oiio::ImageInput::create("openexr");
-  if (!input) throw std::runtime_error(where + ": no OpenEXR reader: " + oiio::geterror());
-  if (!input->supports("ioproxy") || !input->set_ioproxy(&proxy))
-    throw std::runtime_error(where + ": this OpenImageIO's OpenEXR reader cannot read memory");
-  oiio::ImageSpec spec;
-  if (!input->open("memory.exr", spec)) {
-    std::string error = input->geterror();
-    throw std::runtime_error(where + ": cannot decode: " +
-                             (error.empty() ? std::string("corrupt OpenEXR data") : error));
-  }
-  Image color = read_contents(*input, where, metadata, variance);
-  input->close();
-  return color;
+  oiio::Pixels pixels = in_module(where, [&](const oiio::Services& services) {
+    return services.read_exr(bytes, /*from_memory=*/true, kMaxImageSide, kMaxChannels);
+  });
+  return image_of(pixels, where, metadata, variance);
 }
 
-void write_png_preview(const std::string& path, const Image& color, double exposure) {
-  std::string where = "PNG '" + path + "'";
+namespace {
+
+std::string encode_png_for(const std::string& where, const Image& color, double exposure) {
   check_image_shape(color, "color", where);
   if (!std::isfinite(exposure) || exposure < 0)
     throw std::runtime_error(where + ": exposure must be finite and >= 0, got " +
@@ -304,19 +255,20 @@ void write_png_preview(const std::string& path, const Image& color, double expos
     pixels[i] = uint8_t(std::lround(encoded * 255.0));
   }
 
-  oiio::ImageSpec spec(color.width, color.height, 3, oiio::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  auto output = oiio::ImageOutput::create("png");
-  if (!output) throw std::runtime_error(where + ": no PNG writer: " + oiio::geterror());
-  if (!output->open(path, spec))
-    throw std::runtime_error(where + ": cannot open for writing: " + output->geterror());
-  if (!output->write_image(oiio::TypeDesc::UINT8, pixels.data())) {
-    std::string error = output->geterror();
-    output->close();
-    throw std::runtime_error(where + ": cannot write pixels: " + error);
-  }
-  if (!output->close())
-    throw std::runtime_error(where + ": cannot finish the file: " + output->geterror());
+  return in_module(where, [&](const oiio::Services& services) {
+    return services.encode_png(pixels.data(), color.width, color.height);
+  });
+}
+
+}  // namespace
+
+std::string encode_png_preview(const Image& color, double exposure) {
+  return encode_png_for("PNG encoding", color, exposure);
+}
+
+void write_png_preview(const std::string& path, const Image& color, double exposure) {
+  std::string where = "PNG '" + path + "'";
+  write_file_atomically(path, encode_png_for(where, color, exposure), where);
 }
 
 }  // namespace penumbra

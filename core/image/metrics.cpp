@@ -11,8 +11,6 @@
 
 namespace penumbra {
 
-namespace {
-
 void check_same_size(const Image& test, const Image& reference) {
   if (test.width != reference.width || test.height != reference.height)
     throw std::invalid_argument("image size mismatch: test is " + std::to_string(test.width) + "x" +
@@ -24,7 +22,6 @@ void check_same_size(const Image& test, const Image& reference) {
     throw std::invalid_argument("image pixel buffer does not hold width*height*3 floats");
 }
 
-// The region clipped to the image; throws when nothing is left.
 Region clip_region(const Region& region, const Image& image) {
   Region clipped{std::max(region.x0, 0), std::max(region.y0, 0), std::min(region.x1, image.width),
                  std::min(region.y1, image.height)};
@@ -35,6 +32,8 @@ Region clip_region(const Region& region, const Image& image) {
         std::to_string(image.width) + "x" + std::to_string(image.height) + " image");
   return clipped;
 }
+
+namespace {
 
 // Mean of error(p, r) over the pixels and channels of a (clipped, non-empty) region.
 template <typename ChannelError>

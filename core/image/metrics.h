@@ -21,6 +21,11 @@ double mse(const Image& test, const Image& reference);
 double mse(const Image& test, const Image& reference, const Region& region);
 double rmse(const Image& test, const Image& reference);
 
+// Throws std::invalid_argument unless both images have the same size and full pixel buffers.
+void check_same_size(const Image& test, const Image& reference);
+// The region clipped to the image; throws std::invalid_argument when nothing is left.
+Region clip_region(const Region& region, const Image& image);
+
 struct ErrorSummary {
   double mrse = 0, mse = 0, rmse = 0;
 };

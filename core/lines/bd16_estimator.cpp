@@ -161,8 +161,10 @@ std::optional<std::string> Bd16LineSampler::unsupported(const Light& light,
         "assume constant radiance)");
   }
   if (material.type != MaterialType::Lambert && material.type != MaterialType::Phong) {
-    return "line-bd16: material '" + material.name +
-           "' is ggx; line-bd16 integrates lines in closed form for lambert and phong only";
+    const char* kind = material.type == MaterialType::Ggx ? "ggx" : "a pbrt-v3 material";
+    return "line-bd16: material '" + material.name + "' is " + kind +
+           "; line-bd16 integrates lines in closed form for lambert and phong only (a pbrt-v3 "
+           "matte is lambert when its Kd is constant, without sigma or bump)";
   }
   return std::nullopt;
 }

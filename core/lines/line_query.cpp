@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <immintrin.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cfloat>
 #include <cmath>
@@ -60,6 +61,7 @@ void set_bounds(void* node, const RTCBounds** bounds, unsigned int child_count, 
 struct BuildStatus {
   std::atomic<bool> oversized_leaf{false};
   const std::vector<OccluderTriangle>* occluders = nullptr;
+  const std::vector<uint32_t>* reference_triangle = nullptr;  // primID -> index in occluders
   double build_scale = 1;  // primitive boxes are the triangles' boxes times this power of two
 };
 
@@ -96,7 +98,8 @@ float round_up(double value) {
 void split_primitive(const RTCBuildPrimitive* primitive, unsigned int dimension, float position,
                      RTCBounds* left_bounds, RTCBounds* right_bounds, void* user) {
   const auto* status = static_cast<const BuildStatus*>(user);
-  const OccluderTriangle& triangle = (*status->occluders)[primitive->primID];
+  const OccluderTriangle& triangle =
+      (*status->occluders)[(*status->reference_triangle)[primitive->primID]];
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   double v[3][3];
   for (int k = 0; k < 3; ++k)
@@ -154,6 +157,170 @@ void split_primitive(const RTCBuildPrimitive* primitive, unsigned int dimension,
     }
     *out[side] = RTCBounds{lo[0], lo[1], lo[2], 0, hi[0], hi[1], hi[2], 0};
   }
+}
+
+// Pre-splitting (before the build, at every quality): a long slanted triangle's box is mostly
+// empty, so every shadow triangle that passes anywhere near it reaches its leaf. Such triangles
+// enter the build as several references, each with the box of one piece of the triangle (the
+// triangle clipped to a half-space, recursively at the middle of the piece's longest axis); the
+// leaves still hold the whole triangle, so the exact test and its watertightness are untouched
+// and a triangle reached through two pieces cuts the same interval twice (subtracting is
+// idempotent). Each piece's box contains that piece: the clipped corners are computed in double
+// (relative error ~1e-16) and the float box is rounded outwards and then widened by one float
+// ulp, far more than that error.
+struct SplitPolygon {
+  static constexpr int kCapacity = 3 + 16;  // a triangle clipped by at most 16 planes
+  int count = 0;
+  double v[kCapacity][3];
+};
+
+struct PreSplitLimits {
+  int max_depth = 10;            // at most 2^max_depth pieces per triangle
+  double min_extent = 0;         // pieces no longer than this along any axis are kept
+  double max_box_to_area = 4.0;  // kept when the box's half surface area <= this x area
+};
+
+void polygon_bounds(const SplitPolygon& polygon, double lower[3], double upper[3]) {
+  for (int axis = 0; axis < 3; ++axis) lower[axis] = upper[axis] = polygon.v[0][axis];
+  for (int k = 1; k < polygon.count; ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      lower[axis] = std::min(lower[axis], polygon.v[k][axis]);
+      upper[axis] = std::max(upper[axis], polygon.v[k][axis]);
+    }
+}
+
+double polygon_area(const SplitPolygon& polygon) {
+  Vec3 sum(0, 0, 0);
+  const Vec3 origin(polygon.v[0][0], polygon.v[0][1], polygon.v[0][2]);
+  for (int k = 1; k + 1 < polygon.count; ++k) {
+    const Vec3 p(polygon.v[k][0], polygon.v[k][1], polygon.v[k][2]);
+    const Vec3 q(polygon.v[k + 1][0], polygon.v[k + 1][1], polygon.v[k + 1][2]);
+    sum += cross(p - origin, q - origin);
+  }
+  return 0.5 * length(sum);
+}
+
+// Sutherland-Hodgman against coordinate[axis] <= plane (below) and >= plane (above); corners on
+// the plane go to both sides, crossings get the plane's coordinate exactly.
+void clip_polygon(const SplitPolygon& in, int axis, double plane, SplitPolygon& below,
+                  SplitPolygon& above) {
+  below.count = above.count = 0;
+  auto add = [](SplitPolygon& polygon, const double* point) {
+    if (polygon.count == SplitPolygon::kCapacity) return;  // unreachable: depth is bounded
+    for (int k = 0; k < 3; ++k) polygon.v[polygon.count][k] = point[k];
+    ++polygon.count;
+  };
+  for (int k = 0; k < in.count; ++k) {
+    const double* p = in.v[k];
+    const double* q = in.v[(k + 1) % in.count];
+    if (p[axis] <= plane) add(below, p);
+    if (p[axis] >= plane) add(above, p);
+    if ((p[axis] < plane && q[axis] > plane) || (p[axis] > plane && q[axis] < plane)) {
+      const double f = (plane - p[axis]) / (q[axis] - p[axis]);
+      double crossing[3];
+      for (int c = 0; c < 3; ++c) crossing[c] = p[c] + f * (q[c] - p[c]);
+      crossing[axis] = plane;
+      add(below, crossing);
+      add(above, crossing);
+    }
+  }
+}
+
+// The float box of a piece (see above), within `limit` (the whole triangle's float box).
+RTCBounds piece_box(const double lower[3], const double upper[3], const RTCBuildPrimitive& limit) {
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  float lo[3], hi[3];
+  const float limit_lower[3] = {limit.lower_x, limit.lower_y, limit.lower_z};
+  const float limit_upper[3] = {limit.upper_x, limit.upper_y, limit.upper_z};
+  for (int axis = 0; axis < 3; ++axis) {
+    lo[axis] = std::max(std::nextafter(round_down(lower[axis]), -kInfinity), limit_lower[axis]);
+    hi[axis] = std::min(std::nextafter(round_up(upper[axis]), kInfinity), limit_upper[axis]);
+  }
+  return RTCBounds{lo[0], lo[1], lo[2], 0, hi[0], hi[1], hi[2], 0};
+}
+
+// Appends the boxes of the pieces of `polygon` (a triangle or a part of one) to `boxes`.
+void split_into_pieces(const SplitPolygon& polygon, int depth, const PreSplitLimits& limits,
+                       const RTCBuildPrimitive& limit, std::vector<RTCBounds>& boxes) {
+  double lower[3], upper[3];
+  polygon_bounds(polygon, lower, upper);
+  const double extent[3] = {upper[0] - lower[0], upper[1] - lower[1], upper[2] - lower[2]};
+  const int axis =
+      extent[0] >= extent[1] ? (extent[0] >= extent[2] ? 0 : 2) : (extent[1] >= extent[2] ? 1 : 2);
+  const double half_area = extent[0] * extent[1] + extent[1] * extent[2] + extent[2] * extent[0];
+  if (depth >= limits.max_depth || !(extent[axis] > limits.min_extent) ||
+      half_area <= limits.max_box_to_area * polygon_area(polygon)) {
+    boxes.push_back(piece_box(lower, upper, limit));
+    return;
+  }
+  const double plane = 0.5 * (lower[axis] + upper[axis]);
+  SplitPolygon below, above;
+  clip_polygon(polygon, axis, plane, below, above);
+  // A side holding fewer than three corners touches the plane only: the other side's box holds
+  // those points.
+  if (below.count >= 3) split_into_pieces(below, depth + 1, limits, limit, boxes);
+  if (above.count >= 3) split_into_pieces(above, depth + 1, limits, limit, boxes);
+}
+
+// Replaces `primitives` (one box per occluder, primID its index) by the references of the
+// pre-split (see split_into_pieces), with reference_triangle[primID] the occluder of each.
+// Triangles are split while a piece is longer than 1/64 of the scene's extent and its box's half
+// surface area is more than 4 times its area (a flat triangle in an axis plane has 2); at most
+// max(n / 2, 65536) references are added to n triangles (the length threshold doubles until
+// they fit).
+void pre_split(const std::vector<OccluderTriangle>& occluders,
+               std::vector<RTCBuildPrimitive>& primitives,
+               std::vector<uint32_t>& reference_triangle) {
+  double scene_lower[3], scene_upper[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    scene_lower[axis] = std::numeric_limits<double>::infinity();
+    scene_upper[axis] = -std::numeric_limits<double>::infinity();
+  }
+  for (const RTCBuildPrimitive& p : primitives) {
+    const float lower[3] = {p.lower_x, p.lower_y, p.lower_z};
+    const float upper[3] = {p.upper_x, p.upper_y, p.upper_z};
+    for (int axis = 0; axis < 3; ++axis) {
+      scene_lower[axis] = std::min<double>(scene_lower[axis], lower[axis]);
+      scene_upper[axis] = std::max<double>(scene_upper[axis], upper[axis]);
+    }
+  }
+  const double scene_extent =
+      std::max({scene_upper[0] - scene_lower[0], scene_upper[1] - scene_lower[1],
+                scene_upper[2] - scene_lower[2]});
+  const size_t budget = occluders.size() + std::max<size_t>(occluders.size() / 2, 65536);
+  PreSplitLimits limits;
+  limits.min_extent = scene_extent / 64;
+  std::vector<RTCBuildPrimitive> split;
+  std::vector<RTCBounds> boxes;
+  for (;;) {
+    split.clear();
+    reference_triangle.clear();
+    for (const RTCBuildPrimitive& whole : primitives) {
+      const OccluderTriangle& triangle = occluders[whole.primID];
+      SplitPolygon polygon;
+      polygon.count = 3;
+      for (int k = 0; k < 3; ++k)
+        for (int axis = 0; axis < 3; ++axis) polygon.v[k][axis] = triangle.coordinate[axis][k];
+      boxes.clear();
+      split_into_pieces(polygon, 0, limits, whole, boxes);
+      for (const RTCBounds& box : boxes) {
+        RTCBuildPrimitive piece = whole;
+        piece.lower_x = box.lower_x;
+        piece.lower_y = box.lower_y;
+        piece.lower_z = box.lower_z;
+        piece.upper_x = box.upper_x;
+        piece.upper_y = box.upper_y;
+        piece.upper_z = box.upper_z;
+        piece.primID = static_cast<unsigned>(split.size());
+        split.push_back(piece);
+        reference_triangle.push_back(whole.primID);
+      }
+      if (split.size() > budget) break;
+    }
+    if (split.size() <= budget) break;
+    limits.min_extent *= 2;
+  }
+  primitives = std::move(split);
 }
 
 RTCBuildQuality embree_quality(LineQueryBuildQuality quality) {
@@ -547,7 +714,15 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   }
   nodes_.clear();
   triangles_.clear();
+  triangle_count_ = occluders.size();
   if (occluders.empty()) return;
+  std::vector<uint32_t> reference_triangle;  // the triangle of each primitive (primID)
+  if (options_.split_long_triangles) {
+    pre_split(occluders, primitives, reference_triangle);
+  } else {
+    reference_triangle.resize(occluders.size());
+    for (size_t i = 0; i < occluders.size(); ++i) reference_triangle[i] = static_cast<uint32_t>(i);
+  }
   // Embree builds on boxes scaled by a power of two to a largest coordinate in [1, 2): its SAH
   // then sees the same numbers at every scene scale (box areas of tiny scenes would otherwise
   // be float denormals, flushed to zero on render threads). Exact both ways.
@@ -561,9 +736,10 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     primitive.upper_y *= build_scale;
     primitive.upper_z *= build_scale;
   }
-  if (occluders.size() >= (size_t{1} << (31 - kCountBits)))
+  if (primitives.size() >= (size_t{1} << (31 - kCountBits)))
     throw std::invalid_argument("LineQuery: too many triangles (" +
-                                std::to_string(occluders.size()) + ")");
+                                std::to_string(occluders.size()) + " in " +
+                                std::to_string(primitives.size()) + " pieces)");
 
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) throw std::runtime_error("LineQuery: cannot create an Embree device");
@@ -605,6 +781,7 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
   arguments.buildProgress = nullptr;
   BuildStatus status;
   status.occluders = &occluders;
+  status.reference_triangle = &reference_triangle;
   status.build_scale = build_scale;
   arguments.userPtr = &status;
   auto* root = static_cast<BuildNode*>(rtcBuildBVH(&arguments));
@@ -632,10 +809,17 @@ void LineQuery::build(const std::vector<Vec3>& positions, const std::vector<uint
     return static_cast<uint32_t>(nodes_.size() - 1);
   };
   auto flatten_leaf = [&](const BuildLeaf* leaf) {
+    // Pieces of one triangle that share a leaf: the triangle once.
     uint32_t first = static_cast<uint32_t>(triangles_.size());
-    for (unsigned i = 0; i < leaf->triangle_count; ++i)
-      triangles_.push_back(occluders[leaf->triangles[i]]);
-    return kLeafFlag | (first << kCountBits) | (leaf->triangle_count - 1);
+    uint32_t in_leaf[RTC_BUILD_MAX_PRIMITIVES_PER_LEAF];
+    unsigned count = 0;
+    for (unsigned i = 0; i < leaf->triangle_count; ++i) {
+      const uint32_t triangle = reference_triangle[leaf->triangles[i]];
+      if (std::find(in_leaf, in_leaf + count, triangle) != in_leaf + count) continue;
+      in_leaf[count++] = triangle;
+      triangles_.push_back(occluders[triangle]);
+    }
+    return kLeafFlag | (first << kCountBits) | (count - 1);
   };
   auto set_slot = [&](uint32_t index, int slot, const RTCBounds& bounds, uint32_t code) {
     Node& node = nodes_[index];

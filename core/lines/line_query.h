@@ -42,6 +42,9 @@ struct LineQueryOptions {
   // triangles; more memory).
   LineQueryBuildQuality build_quality = LineQueryBuildQuality::Medium;
   unsigned max_leaf_size = 4;  // triangles per leaf
+  // Long slanted triangles enter the build as several pieces, each with a tight box (the leaves
+  // still hold the whole triangle: the answers do not change, only which nodes are visited).
+  bool split_long_triangles = true;
   // Run the traversal's AVX build when the CPU has AVX. The SSE2 build computes the same values
   // lane by lane (tests compare both): results and culling do not depend on it, only speed.
   bool allow_avx = true;
@@ -75,8 +78,13 @@ class LineQuery {
   // (a shadow ray through this structure).
   bool occluded(const Vec3& x, const Vec3& p) const;
 
-  size_t triangle_count() const { return triangles_.size(); }
+  // Occluder triangles (after dropping those that cannot occlude).
+  size_t triangle_count() const { return triangle_count_; }
   size_t node_count() const { return nodes_.size(); }
+  // Bytes of the BVH's nodes and triangles.
+  size_t memory_bytes() const {
+    return nodes_.capacity() * sizeof(Node) + triangles_.capacity() * sizeof(OccluderTriangle);
+  }
   const LineQueryOptions& options() const { return options_; }
 
   // One BVH8 node: the boxes of its eight children as centre and half extent (each box
@@ -89,6 +97,11 @@ class LineQuery {
     float extent[3][kWidth];  // [axis][child], >= 0
     uint32_t child[kWidth];   // inner node index, or kLeafFlag | first << kCountBits | count - 1
   };
+  // Read-only views of the BVH for other traversals of it (core/exact's shadow-pyramid query).
+  const std::vector<Node>& nodes() const { return nodes_; }
+  // The leaves' triangles in leaf order: a triangle split into pieces (split_long_triangles)
+  // appears once in each leaf one of its pieces reached.
+  const std::vector<OccluderTriangle>& triangles() const { return triangles_; }
   // True when queries run the AVX build (options().allow_avx and the CPU has AVX).
   bool uses_avx() const { return use_avx_; }
   static constexpr uint32_t kLeafFlag = 0x80000000u;
@@ -100,6 +113,7 @@ class LineQuery {
   LineQueryOptions options_;
   std::vector<Node> nodes_;                  // nodes_[0] is the root
   std::vector<OccluderTriangle> triangles_;  // in leaf order
+  size_t triangle_count_ = 0;
   Vec3 scene_max_abs_;     // per axis, the largest |coordinate| (float error bounds)
   bool prefetch_ = false;  // nodes and triangles exceed a typical L2 cache: prefetch children
   bool use_avx_ = false;

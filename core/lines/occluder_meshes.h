@@ -2,6 +2,10 @@
 // Procedural occluder meshes for the line query's tests and benchmarks: subdivided boxes,
 // icospheres, UV spheres and random triangle soups, as flat position and index arrays like a
 // Scene's. Boxes and spheres are closed (watertight) meshes.
+//
+// Their own namespace: core/scene/shape_mesh.h has a different penumbra::TriangleMesh and a
+// penumbra::icosphere_mesh with the same signature. Two definitions under one name would break
+// the one-definition rule (the linker keeps one of them for every caller).
 
 #include <array>
 #include <cmath>
@@ -13,7 +17,7 @@
 
 #include "core/math/vec.h"
 
-namespace penumbra {
+namespace penumbra::occluder_meshes {
 
 struct TriangleMesh {
   std::vector<Vec3> positions;
@@ -162,4 +166,4 @@ inline TriangleMesh random_triangles_mesh(size_t count, const Vec3& lower, const
   return mesh;
 }
 
-}  // namespace penumbra
+}  // namespace penumbra::occluder_meshes

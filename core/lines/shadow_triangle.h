@@ -163,12 +163,26 @@ inline bool ShadowTriangle::set(const Vec3& x_in, const Vec3& a, const Vec3& b,
 
 inline std::optional<Interval> occluder_cut(const ShadowTriangle& shadow,
                                             const OccluderTriangle& occluder) {
-  // Two rejections, decided together (bitwise, so that the many triangles a node test lets
-  // through cost one hard-to-predict branch instead of one per test):
+  // Rejections, cheapest first:
+  // - the occluder against the shadow plane (three signed distances, one 4-wide evaluation):
+  //   entirely on one side, no crossing; in the plane, coplanar, does not occlude. Most
+  //   triangles a node test lets through and that do not cut fail here;
   // - the shadow triangle against the occluder's plane (Möller 1997's other rejection): x on
-  //   the plane means edge-on; x, a, b strictly on one side means no crossing;
-  // - the occluder against the shadow plane: entirely on one side, no crossing; in the plane,
-  //   coplanar, does not occlude.
+  //   the plane means edge-on; x, a, b strictly on one side means no crossing. Decided together
+  //   (bitwise: one hard-to-predict branch instead of one per test).
+  using lanes::D2;
+  using lanes::D4;
+  const D4 qx = lanes::widen(occluder.coordinate[0]) - shadow.x.x;
+  const D4 qy = lanes::widen(occluder.coordinate[1]) - shadow.x.y;
+  const D4 qz = lanes::widen(occluder.coordinate[2]) - shadow.x.z;
+  const Vec3& n = shadow.plane_normal;
+  const D4 distance = qx * n.x + qy * n.y + qz * n.z;
+  const double d[3] = {distance[0], distance[1], distance[2]};
+  const bool occluder_on_one_side = ((d[0] > 0) & (d[1] > 0) & (d[2] > 0)) |
+                                    ((d[0] < 0) & (d[1] < 0) & (d[2] < 0)) |
+                                    ((d[0] == 0) & (d[1] == 0) & (d[2] == 0));
+  if (occluder_on_one_side) return std::nullopt;
+
   const Vec3 v0 = occluder.vertex(0), v1 = occluder.vertex(1), v2 = occluder.vertex(2);
   const Vec3 occluder_normal = cross(v1 - v0, v2 - v0);
   const double x_side = dot(occluder_normal, shadow.x - v0);
@@ -178,25 +192,14 @@ inline std::optional<Interval> occluder_cut(const ShadowTriangle& shadow,
       x_side * x_side <= shadow.self_occlusion_distance_squared * length_squared(occluder_normal);
   const bool shadow_on_one_side =
       ((x_side > 0) & (a_side > 0) & (b_side > 0)) | ((x_side < 0) & (a_side < 0) & (b_side < 0));
+  if (edge_on | shadow_on_one_side) return std::nullopt;
 
-  // The vertices' signed distances to the shadow plane and their in-plane coordinates alpha and
-  // beta, all three vertices at once: per lane the same operations as dot(v - x, gradient).
-  using lanes::D2;
-  using lanes::D4;
-  const D4 qx = lanes::widen(occluder.coordinate[0]) - shadow.x.x;
-  const D4 qy = lanes::widen(occluder.coordinate[1]) - shadow.x.y;
-  const D4 qz = lanes::widen(occluder.coordinate[2]) - shadow.x.z;
-  const Vec3& n = shadow.plane_normal;
+  // The vertices' in-plane coordinates alpha and beta, all three at once: per lane the same
+  // operations as dot(v - x, gradient).
   const Vec3& ga = shadow.alpha_gradient;
   const Vec3& gb = shadow.beta_gradient;
-  const D4 distance = qx * n.x + qy * n.y + qz * n.z;
   const D4 alpha = qx * ga.x + qy * ga.y + qz * ga.z;
   const D4 beta = qx * gb.x + qy * gb.y + qz * gb.z;
-  const double d[3] = {distance[0], distance[1], distance[2]};
-  const bool occluder_on_one_side = ((d[0] > 0) & (d[1] > 0) & (d[2] > 0)) |
-                                    ((d[0] < 0) & (d[1] < 0) & (d[2] < 0)) |
-                                    ((d[0] == 0) & (d[1] == 0) & (d[2] == 0));
-  if (edge_on | shadow_on_one_side | occluder_on_one_side) return std::nullopt;
 
   // Endpoints of the crossing segment in homogeneous form: a point (alpha, beta) = numerator /
   // weight. A vertex on the plane is one endpoint (weight 1); an edge whose vertices lie

@@ -76,6 +76,8 @@ double mixture_pdf(const Material& m, const Vec3& n, const Vec3& wo, const Vec3&
                           : 0.0;
       return p_diffuse * cos_i * kInvPi + (1.0 - p_diffuse) * specular;
     }
+    default:  // the pbrt-v3 materials: core/materials/surface_bsdf.h
+      break;
   }
   return 0;
 }
@@ -106,6 +108,8 @@ Rgb eval_bsdf(const Material& m, const Vec3& n, const Vec3& wo, const Vec3& wi) 
       }
       return m.diffuse * kInvPi + fresnel * microfacet;
     }
+    default:
+      break;
   }
   return {0, 0, 0};
 }
@@ -153,6 +157,8 @@ std::optional<BsdfSample> sample_bsdf(const Material& m, const Vec3& n, const Ve
       }
       break;
     }
+    default:
+      return std::nullopt;
   }
   double length_wi = length(wi);
   if (!(length_wi > 0) || !std::isfinite(length_wi)) return std::nullopt;

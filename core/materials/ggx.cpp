@@ -44,8 +44,13 @@ Rgb schlick_fresnel(const Rgb& f0, double cos_theta) {
 }
 
 Vec3 sample_ggx_visible_normal(const Vec3& wo_local, double alpha, const Vec2& u) {
+  return sample_ggx_visible_normal(wo_local, alpha, alpha, u);
+}
+
+Vec3 sample_ggx_visible_normal(const Vec3& wo_local, double alpha_x, double alpha_y,
+                               const Vec2& u) {
   // Heitz 2018, Listing 1. Stretch wo to the hemisphere configuration.
-  Vec3 vh = normalize(Vec3{alpha * wo_local.x, alpha * wo_local.y, wo_local.z});
+  Vec3 vh = normalize(Vec3{alpha_x * wo_local.x, alpha_y * wo_local.y, wo_local.z});
   // Orthonormal basis around vh (vh.z >= 0).
   double lensq = vh.x * vh.x + vh.y * vh.y;
   Vec3 t1 = lensq > 0 ? Vec3{-vh.y, vh.x, 0} / std::sqrt(lensq) : Vec3{1, 0, 0};
@@ -59,7 +64,7 @@ Vec3 sample_ggx_visible_normal(const Vec3& wo_local, double alpha, const Vec2& u
   p2 = (1.0 - s) * safe_sqrt(1.0 - p1 * p1) + s * p2;
   // Reproject onto the hemisphere and unstretch.
   Vec3 nh = p1 * t1 + p2 * t2 + safe_sqrt(1.0 - p1 * p1 - p2 * p2) * vh;
-  Vec3 ne{alpha * nh.x, alpha * nh.y, std::max(0.0, nh.z)};
+  Vec3 ne{alpha_x * nh.x, alpha_y * nh.y, std::max(0.0, nh.z)};
   double ne_length = length(ne);
   if (!(ne_length > 0)) return {0, 0, 1};
   return ne / ne_length;

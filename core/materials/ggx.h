@@ -29,6 +29,8 @@ Rgb schlick_fresnel(const Rgb& f0, double cos_theta);
 // Heitz 2018, "Sampling the GGX distribution of visible normals": a half vector drawn with
 // density D_wo(h) = G1(wo) max(0, wo.h) D(h) / cos_o, for wo_local.z > 0.
 Vec3 sample_ggx_visible_normal(const Vec3& wo_local, double alpha, const Vec2& u);
+// The same with anisotropic roughness (alpha_x along the local x axis, alpha_y along y).
+Vec3 sample_ggx_visible_normal(const Vec3& wo_local, double alpha_x, double alpha_y, const Vec2& u);
 // Density of wi = reflect(wo, h) with h from sample_ggx_visible_normal, in solid angle:
 // D_wo(h) / (4 |wo.h|) = G1(wo) D(h) / (4 cos_o). Zero below the horizon.
 double ggx_reflection_pdf(const Vec3& wo_local, const Vec3& wi_local, double alpha);

@@ -7,41 +7,32 @@
 #include <variant>
 
 #include "core/lights/light_geometry.h"
-#include "core/lines/bd16_estimator.h"
-#include "core/lines/line_sampling_area.h"
-#include "core/lines/line_sampling_solid_angle.h"
 #include "core/materials/bsdf.h"
+#include "core/method/combination.h"
+#include "core/method/method_check.h"
 #include "core/method/smoothing.h"
-#include "core/polygon/ltc_strategy.h"
-#include "core/polygon/ltc_unshadowed_shading.h"
-#include "core/polygon/peters_mis.h"
-#include "core/polygon/polygon_light.h"
-#include "core/polygon/psa_strategy.h"
-#include "core/strategies/area_strategy.h"
-#include "core/strategies/bsdf_strategy.h"
-#include "core/strategies/solid_angle_strategy.h"
+#include "core/method/unshadowed_integrals.h"
+#include "core/strategies/registered_strategies.h"
 
 namespace penumbra {
 
 namespace {
 
-// monostate: not prepared (never sampled or evaluated).
-using PreparedStrategy = std::variant<std::monostate, AreaStrategy, SolidAngleStrategy,
-                                      BsdfStrategy, ProjectedSolidAngleStrategy, LtcStrategy,
-                                      LineAreaStrategy, LineSolidAngleStrategy>;
+// ---- Strategies: the prepared strategy of a term, its samples and densities ---------------------
 
-template <typename T>
-constexpr bool is_line_type =
-    std::is_same_v<T, LineAreaStrategy> || std::is_same_v<T, LineSolidAngleStrategy>;
+// Every term's prepared strategy is a PreparedStrategy (the registry's variant,
+// core/strategies/registered_strategies.h); its family says which entry points it has.
 
 std::optional<LightPoint> sample_strategy(const PreparedStrategy& strategy, const Vec2& u) {
   return std::visit(
       [&](const auto& s) -> std::optional<LightPoint> {
         using T = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<T, std::monostate> || is_line_type<T>)
+        if constexpr (std::is_same_v<T, std::monostate>)
           return std::nullopt;
-        else
+        else if constexpr (T::kFamily == StrategyFamily::Point)
           return s.sample(u);
+        else
+          return std::nullopt;
       },
       strategy);
 }
@@ -50,61 +41,45 @@ double pdf_strategy(const PreparedStrategy& strategy, const Vec3& point) {
   return std::visit(
       [&](const auto& s) -> double {
         using T = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<T, std::monostate> || is_line_type<T>)
+        if constexpr (std::is_same_v<T, std::monostate>)
           return 0.0;
-        else
+        else if constexpr (T::kFamily == StrategyFamily::Point)
           return s.pdf(point);
+        else
+          return 0.0;
       },
       strategy);
-}
-
-LineAxis line_axis(LineDirection direction) {
-  return direction == LineDirection::V ? LineAxis::Edge2 : LineAxis::Edge1;
 }
 
 // The line of a line term's sample, or the pdf of a line term given the traced line through a
 // point (its own direction's line) and the point's t on it.
 std::optional<LightPoint> sample_line(const PreparedStrategy& strategy, const Vec2& u,
                                       TracedLine& line, double& t) {
-  if (const auto* s = std::get_if<LineAreaStrategy>(&strategy)) return s->sample(u, line, t);
-  if (const auto* s = std::get_if<LineSolidAngleStrategy>(&strategy)) return s->sample(u, line, t);
-  return std::nullopt;
+  return std::visit(
+      [&](const auto& s) -> std::optional<LightPoint> {
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, std::monostate>)
+          return std::nullopt;
+        else if constexpr (T::kFamily == StrategyFamily::Line)
+          return s.sample(u, line, t);
+        else
+          return std::nullopt;
+      },
+      strategy);
 }
 double pdf_line(const PreparedStrategy& strategy, const TracedLine& line, double t,
                 const Vec3& point) {
-  if (const auto* s = std::get_if<LineAreaStrategy>(&strategy)) return s->pdf(line, t);
-  if (const auto* s = std::get_if<LineSolidAngleStrategy>(&strategy)) return s->pdf(line, t, point);
-  return 0;
-}
-
-PreparedStrategy prepare(const MethodTerm& term, const ShadingPoint& sp, const Light& light,
-                         const LineQuery* lines) {
-  switch (term.strategy) {
-    case StrategyKind::LineArea:
-      if (lines) return LineAreaStrategy(sp, light, line_axis(term.direction), *lines);
-      break;
-    case StrategyKind::LineSolidAngle:
-      if (lines) return LineSolidAngleStrategy(sp, light, line_axis(term.direction), *lines);
-      break;
-    default:
-      break;
-  }
-  switch (term.strategy) {
-    case StrategyKind::Area:
-      return AreaStrategy(sp, light);
-    case StrategyKind::SolidAngle:
-      return SolidAngleStrategy(sp, light);
-    case StrategyKind::Bsdf:
-      return BsdfStrategy(sp, light);
-    case StrategyKind::ProjectedSolidAngle:
-      return ProjectedSolidAngleStrategy(sp, light);
-    case StrategyKind::Ltc:
-      return LtcStrategy(sp, light);
-    default:
-      break;
-  }
-  // The constructor of DirectLighting refuses every other kind before we get here.
-  return std::monostate{};
+  return std::visit(
+      [&](const auto& s) -> double {
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, std::monostate>)
+          return 0.0;
+        else if constexpr (T::kFamily == StrategyFamily::Line)
+          return s.pdf(line, t, point);
+        else
+          return 0.0;
+      },
+      strategy);
 }
 
 // Aspect of the 2D strata: strategies that map u.x along edge1 and u.y along edge2 of a quad.
@@ -113,10 +88,12 @@ PreparedStrategy prepare(const MethodTerm& term, const ShadingPoint& sp, const L
 // at N = 4^k (cmj still stratifies every 1D projection, the line offsets included, in N strata).
 double strata_aspect(const MethodTerm& term, const Light& light) {
   if (light.type != LightType::Quad) return 1.0;
-  if (term.strategy != StrategyKind::Area && term.strategy != StrategyKind::SolidAngle) return 1.0;
+  if (!strategy_info(term.strategy).rectangle_strata) return 1.0;
   double e1 = length(light.edge1), e2 = length(light.edge2);
   return (e1 > 0 && e2 > 0) ? e1 / e2 : 1.0;
 }
+
+// ---- The integrand ------------------------------------------------------------------------------
 
 // The unoccluded integrand in area measure: f(wo, wi) cos_x Le cos_l / r^2.
 Rgb unshadowed_integrand(const ShadingPoint& sp, const Light& light, const Vec3& point) {
@@ -130,7 +107,7 @@ Rgb unshadowed_integrand(const ShadingPoint& sp, const Light& light, const Vec3&
   if (cos_x <= 0 || cos_l <= 0) return {};
   Rgb le = emitted_radiance(light, point, -wi);
   if (is_black(le)) return {};
-  Rgb f = eval_bsdf(*sp.material, sp.normal, sp.wo, wi);
+  Rgb f = shading_bsdf(sp, wi);
   return f * le * (cos_x * cos_l / r2);
 }
 
@@ -150,26 +127,7 @@ bool light_reaches_point(const ShadingPoint& sp, const Light& light) {
   return false;
 }
 
-double weight_of(Combine combine, int term, std::span<const double> scaled_pdfs) {
-  // scaled_pdfs[k] = n_k p_k
-  int terms = int(scaled_pdfs.size());
-  if (terms == 1) return 1.0;
-  switch (combine) {
-    case Combine::Avg:
-      return 1.0 / terms;
-    case Combine::Power: {
-      double sum = 0;
-      for (double p : scaled_pdfs) sum += p * p;
-      return sum > 0 ? scaled_pdfs[term] * scaled_pdfs[term] / sum : 0.0;
-    }
-    case Combine::Balance:
-    default: {
-      double sum = 0;
-      for (double p : scaled_pdfs) sum += p;
-      return sum > 0 ? scaled_pdfs[term] / sum : 0.0;
-    }
-  }
-}
+// ---- Prepared terms of one (shading point, light) -----------------------------------------------
 
 // The prepared strategies of one (shading point, light), constructed in place. Not an array of
 // variants or optionals: those value-initialize (zero) their whole storage, and a psa strategy
@@ -182,8 +140,25 @@ class PreparedTerms {
   ~PreparedTerms() {
     for (size_t i = 0; i < count_; ++i) at(i).~PreparedStrategy();
   }
-  void emplace_back(PreparedStrategy&& strategy) {
-    new (storage_[count_++]) PreparedStrategy(std::move(strategy));
+  // Prepares the term's strategy in place, with its family's constructor. A line term without a
+  // line query (weights() for tests) stays unprepared: no samples, density 0.
+  void prepare(const MethodTerm& term, const ShadingPoint& sp, const Light& light,
+               const LineQuery* lines) {
+    void* slot = storage_[count_++];
+    RegisteredStrategies::visit_row(term.strategy, [&]<typename T>() {
+      constexpr size_t index = RegisteredStrategies::id_of<T>() + 1;
+      if constexpr (T::kFamily == StrategyFamily::Point) {
+        new (slot) PreparedStrategy(std::in_place_index<index>, sp, light);
+      } else if constexpr (T::kFamily == StrategyFamily::Line) {
+        if (lines)
+          new (slot) PreparedStrategy(std::in_place_index<index>, sp, light,
+                                      line_axis(term.direction), *lines);
+        else
+          new (slot) PreparedStrategy();
+      } else {
+        new (slot) PreparedStrategy(std::in_place_index<index>, sp, light, term.direction);
+      }
+    });
   }
   const PreparedStrategy& operator[](size_t i) const {
     return *std::launder(reinterpret_cast<const PreparedStrategy*>(storage_[i]));
@@ -197,67 +172,7 @@ class PreparedTerms {
   size_t count_ = 0;
 };
 
-// Peters 2021 Sec. 4.2-4.3: `psa+ltc/weighted` and `psa+ltc/clamped-optimal`. The weights are per
-// colour channel and need the unshadowed integrals c_j of the shading point and light
-// (core/polygon/peters_mis.h, ltc_unshadowed_shading.h); technique 0 is psa, 1 is ltc.
-bool peters_combination(Combine combine) {
-  return combine == Combine::Weighted || combine == Combine::ClampedOptimal;
-}
-PetersHeuristic peters_heuristic(Combine combine) {
-  return combine == Combine::Weighted ? PetersHeuristic::Weighted : PetersHeuristic::ClampedOptimal;
-}
-int peters_technique(const MethodTerm& term) {
-  return term.strategy == StrategyKind::Ltc ? 1 : 0;
-}
-
-// What Peters' combination needs of one (shading point, light): c_j, the counts n_j (times the
-// multiplier) and which term is which technique.
-struct PetersTerms {
-  UnshadowedIntegrals unshadowed{};
-  TechniqueCounts counts{0, 0};
-  size_t term_of[kPetersTechniques] = {0, 1};
-};
-
-PetersTerms prepare_peters(const MethodSpec& method, const PreparedTerms& prepared,
-                           const ShadingPoint& sp, const Light& light, int multiplier) {
-  PetersTerms peters;
-  const ProjectedSolidAngleStrategy* psa = nullptr;
-  const LtcStrategy* ltc = nullptr;
-  for (size_t k = 0; k < method.terms.size(); ++k) {
-    int j = peters_technique(method.terms[k]);
-    peters.term_of[j] = k;
-    peters.counts[j] = method.terms[k].count * multiplier;
-    if (j == 0) psa = std::get_if<ProjectedSolidAngleStrategy>(&prepared[k]);
-    if (j == 1) ltc = std::get_if<LtcStrategy>(&prepared[k]);
-  }
-  if (psa && ltc) peters.unshadowed = unshadowed_polygon_shading(sp, light, *psa, *ltc);
-  return peters;
-}
-
-// The densities of both techniques at a sample of technique j (its own pdf given).
-TechniqueDensities peters_densities(const PetersTerms& peters, const PreparedTerms& prepared, int j,
-                                    double own_pdf, const Vec3& point) {
-  TechniqueDensities pdfs;
-  for (int k = 0; k < kPetersTechniques; ++k)
-    pdfs[k] = k == j ? own_pdf : pdf_strategy(prepared[peters.term_of[k]], point);
-  return pdfs;
-}
-
-[[noreturn]] void refuse(const MethodSpec& method, const std::string& why) {
-  throw FormatError("method", "\"" + to_string(method) + "\": " + why);
-}
-
-std::string_view light_type_name(LightType type) {
-  switch (type) {
-    case LightType::Quad:
-      return "quad";
-    case LightType::Polygon:
-      return "polygon";
-    case LightType::Disk:
-      return "disk";
-  }
-  return "light";
-}
+// ---- Lines through a point of the light (line densities, the smoothing factor) ------------------
 
 bool smoothing(Combine combine) {
   return combine == Combine::Smooth || combine == Combine::SmoothFixed;
@@ -307,13 +222,40 @@ class PointLines {
   bool traced_[2] = {false, false};
 };
 
-// The combination weight of a sample of term `term` at `point` (its own pdf `own_pdf`).
+// ---- Combination: the terms' densities at a sample and its weight -------------------------------
+
+// Salesin & Jarosz Eq. 23-24 at a point of the light: the light-edge factor along both edges
+// times, for `smooth`, the occluder-edge factor of every line direction the method traces.
+// 1 where the light has no line family (not a quad).
+double smoothing_factor(const MethodSpec& method, const LightLines& lines, PointLines& point_lines,
+                        const LineQuery* query, const Vec3& point) {
+  const auto& along_edge1 = lines.family[int(LineAxis::Edge1)];
+  if (!along_edge1) return 1.0;
+  Vec2 st = along_edge1->coordinates(point);  // (fraction along edge2, fraction along edge1)
+  double side1 = along_edge1->along_length(), side2 = along_edge1->across_length();
+  double factor = light_edge_smoothing(st.y * side1, side1, lines.smoothing_width) *
+                  light_edge_smoothing(st.x * side2, side2, lines.smoothing_width);
+  if (method.combine == Combine::Smooth && query) {
+    for (int a = 0; a < 2 && factor > 0; ++a) {
+      if (!lines.needed[a] || !lines.family[a]) continue;
+      double t;
+      const TracedLine& line = point_lines.get(LineAxis(a), point, *lines.family[a], *query, t);
+      factor *=
+          occluder_edge_smoothing(line, t, lines.family[a]->along_length(), lines.smoothing_width);
+    }
+  }
+  return factor;
+}
+
+// The combination weight of a sample of term `term` at `point` (its own pdf `own_pdf`): every
+// other term's density at the point (a line query for line terms), then the heuristic
+// (core/method/combination.h). Peters' per-channel heuristics are apart (below).
 double combination_weight(const MethodSpec& method, const PreparedTerms& prepared,
                           const LightLines& lines, PointLines& point_lines, const LineQuery* query,
                           size_t term, double own_pdf, const Vec3& point, int multiplier) {
   const size_t term_count = method.terms.size();
   if (term_count == 1) return 1.0;
-  if (method.combine == Combine::Avg) return 1.0 / double(term_count);
+  if (method.combine == Combine::Avg) return average_weight(term_count);
   double scaled[kMaxMethodTerms];
   for (size_t k = 0; k < term_count; ++k) {
     const MethodTerm& other = method.terms[k];
@@ -334,37 +276,22 @@ double combination_weight(const MethodSpec& method, const PreparedTerms& prepare
     }
     scaled[k] = double(other.count) * multiplier * pdf;
   }
-  std::span<const double> plain(scaled, term_count);
-  if (!smoothing(method.combine)) return weight_of(method.combine, int(term), plain);
-
-  // Salesin & Jarosz Eq. 22-24: ease the BSDF terms' pdfs to 0 at discontinuities.
-  const auto& along_edge1 = lines.family[int(LineAxis::Edge1)];
-  double factor = 1.0;
-  if (along_edge1) {
-    Vec2 st = along_edge1->coordinates(point);  // (fraction along edge2, fraction along edge1)
-    double side1 = along_edge1->along_length(), side2 = along_edge1->across_length();
-    factor = light_edge_smoothing(st.y * side1, side1, lines.smoothing_width) *
-             light_edge_smoothing(st.x * side2, side2, lines.smoothing_width);
-    if (method.combine == Combine::Smooth && query) {
-      for (int a = 0; a < 2 && factor > 0; ++a) {
-        if (!lines.needed[a] || !lines.family[a]) continue;
-        double t;
-        const TracedLine& line = point_lines.get(LineAxis(a), point, *lines.family[a], *query, t);
-        factor *= occluder_edge_smoothing(line, t, lines.family[a]->along_length(),
-                                          lines.smoothing_width);
-      }
+  std::span<const double> scaled_pdfs(scaled, term_count);
+  switch (method.combine) {
+    case Combine::Power:
+      return power_weight(scaled_pdfs, term);
+    case Combine::Smooth:
+    case Combine::SmoothFixed: {
+      // Salesin & Jarosz Eq. 22: the BSDF terms' densities eased at discontinuities.
+      bool eased[kMaxMethodTerms];
+      for (size_t k = 0; k < term_count; ++k)
+        eased[k] = method.terms[k].strategy == strategy_id<BsdfStrategy>;
+      double factor = smoothing_factor(method, lines, point_lines, query, point);
+      return smoothed_balance_weight(scaled_pdfs, {eased, term_count}, factor, term);
     }
+    default:
+      return balance_weight(scaled_pdfs, term);
   }
-  double smoothed[kMaxMethodTerms];
-  double sum = 0;
-  for (size_t k = 0; k < term_count; ++k) {
-    smoothed[k] = method.terms[k].strategy == StrategyKind::Bsdf ? scaled[k] * factor : scaled[k];
-    sum += smoothed[k];
-  }
-  // Where every smoothed pdf vanishes (only BSDF terms, at an edge) the plain balance heuristic
-  // keeps the weights summing to one.
-  if (!(sum > 0)) return weight_of(Combine::Balance, int(term), plain);
-  return smoothed[term] / sum;
 }
 
 LightLines prepare_light_lines(const MethodSpec& method, const ShadingPoint& sp,
@@ -384,129 +311,73 @@ LightLines prepare_light_lines(const MethodSpec& method, const ShadingPoint& sp,
   return lines;
 }
 
+// ---- Peters' per-channel combination (one psa and one ltc term) ---------------------------------
+
+// Peters 2021 Sec. 4.2-4.3: `psa+ltc/weighted` and `psa+ltc/clamped-optimal`. The weights are per
+// colour channel and need the unshadowed integrals c_j of the shading point and light
+// (core/method/combination.h, unshadowed_integrals.h); technique 0 is psa, 1 is ltc.
+bool peters_combination(Combine combine) {
+  return combine == Combine::Weighted || combine == Combine::ClampedOptimal;
+}
+PetersHeuristic peters_heuristic(Combine combine) {
+  return combine == Combine::Weighted ? PetersHeuristic::Weighted : PetersHeuristic::ClampedOptimal;
+}
+int peters_technique(const MethodTerm& term) {
+  return term.strategy == strategy_id<LtcStrategy> ? 1 : 0;
+}
+
+// What Peters' combination needs of one (shading point, light): c_j, the counts n_j (times the
+// multiplier) and which term is which technique.
+struct PetersTerms {
+  UnshadowedIntegrals unshadowed{};
+  TechniqueCounts counts{0, 0};
+  size_t term_of[kPetersTechniques] = {0, 1};
+};
+
+PetersTerms prepare_peters(const MethodSpec& method, const PreparedTerms& prepared,
+                           const ShadingPoint& sp, const Light& light, int multiplier) {
+  PetersTerms peters;
+  const ProjectedSolidAngleStrategy* psa = nullptr;
+  const LtcStrategy* ltc = nullptr;
+  for (size_t k = 0; k < method.terms.size(); ++k) {
+    int j = peters_technique(method.terms[k]);
+    peters.term_of[j] = k;
+    peters.counts[j] = method.terms[k].count * multiplier;
+    if (j == 0) psa = std::get_if<ProjectedSolidAngleStrategy>(&prepared[k]);
+    if (j == 1) ltc = std::get_if<LtcStrategy>(&prepared[k]);
+  }
+  if (psa && ltc) peters.unshadowed = unshadowed_polygon_shading(sp, light, *psa, *ltc);
+  return peters;
+}
+
+// The densities of both techniques at a sample of technique j (its own pdf given).
+TechniqueDensities peters_densities(const PetersTerms& peters, const PreparedTerms& prepared, int j,
+                                    double own_pdf, const Vec3& point) {
+  TechniqueDensities pdfs;
+  for (int k = 0; k < kPetersTechniques; ++k)
+    pdfs[k] = k == j ? own_pdf : pdf_strategy(prepared[peters.term_of[k]], point);
+  return pdfs;
+}
+
+// ---- Billen & Dutré's analytic lines ------------------------------------------------------------
+
 // Billen & Dutré's line-bd16 term: n analytic line estimates with 1D-stratified offsets and
 // one direction per shading point (used by :rand), times the combination weight (1 or 1/T).
-Rgb bd16_estimate(const ShadingPoint& sp, const Light& light, const MethodTerm& term,
-                  const LineQuery& query, Pattern pattern, const StreamKey& stream, int n,
-                  double weight) {
-  thread_local std::vector<double> offsets;
-  offsets.resize(n);
-  generate_1d(pattern, stream, offsets);
-  // The direction's two numbers come from a counter no pattern sample uses.
-  constexpr uint32_t kDirectionSample = 0xffffffffu;
-  Vec2 direction_u{random_uniform(stream, kDirectionSample, 0),
-                   random_uniform(stream, kDirectionSample, 1)};
-  Bd16Direction mode = term.direction == LineDirection::U   ? Bd16Direction::U
-                       : term.direction == LineDirection::V ? Bd16Direction::V
-                                                            : Bd16Direction::Random;
-  Bd16LineSampler sampler(light, *sp.material, sp.position, sp.normal, sp.wo, mode);
-  Rgb sum;
-  for (double offset : offsets) sum += sampler.estimate(offset, direction_u, query);
-  Rgb contribution = sum * (weight / double(n));
+Rgb analytic_line_estimate(const PreparedStrategy& prepared, const LineQuery& query,
+                           Pattern pattern, const StreamKey& stream, int n, double weight) {
+  const auto* strategy = std::get_if<LineBd16Strategy>(&prepared);
+  if (!strategy) return {};
+  Rgb contribution = strategy->estimate_sum(pattern, stream, n, query) * (weight / double(n));
   return is_finite(contribution) ? contribution : Rgb{};
 }
 
 }  // namespace
 
+// ---- The estimator ------------------------------------------------------------------------------
+
 DirectLighting::DirectLighting(const Scene& scene, const MethodSpec& method)
     : scene_(&scene), method_(method) {
-  auto refuse_non_quads = [&](std::string_view what, std::string_view why) {
-    for (size_t l = 0; l < scene.lights.size(); ++l)
-      if (scene.lights[l].type != LightType::Quad)
-        refuse(method, std::string(what) + " " + std::string(why) + "; light " + std::to_string(l) +
-                           " is a " + std::string(light_type_name(scene.lights[l].type)));
-  };
-  for (const MethodTerm& term : method.terms) {
-    std::string name(strategy_name(term.strategy));
-    switch (term.strategy) {
-      case StrategyKind::Area:
-      case StrategyKind::SolidAngle:
-      case StrategyKind::Bsdf:
-        break;
-      case StrategyKind::ProjectedSolidAngle:
-      case StrategyKind::Ltc:
-        for (size_t l = 0; l < scene.lights.size(); ++l)
-          if (scene.lights[l].type == LightType::Disk)
-            refuse(method, "strategy \"" + name + "\" samples polygons and quads; light " +
-                               std::to_string(l) + " is a disk (use sa or area)");
-          else if (!is_polygon_light(scene.lights[l]))
-            refuse(method, "strategy \"" + name + "\" samples polygons of up to " +
-                               std::to_string(kMaxPolygonVertices) + " vertices; light " +
-                               std::to_string(l) + " has " +
-                               std::to_string(scene.lights[l].vertices.size()) +
-                               " (use sa or area)");
-        break;
-      case StrategyKind::LineArea:
-      case StrategyKind::LineSolidAngle:
-        if (term.direction == LineDirection::Rand)
-          refuse(method, "strategy \"" + name +
-                             ":rand\" is not defined: a random line direction per shading point "
-                             "has no closed-form pdf at a point (MIS and Salesin & Jarosz's point "
-                             "interpretation need it), and Ureña's parametrization follows the "
-                             "light's edges; use :u or :v");
-        refuse_non_quads("strategy \"" + name + "\"",
-                         "samples lines of quad lights (along edge1 or edge2)");
-        if (term.strategy == StrategyKind::LineSolidAngle) {
-          for (size_t l = 0; l < scene.lights.size(); ++l)
-            if (!LineSolidAngleStrategy::supports(scene.lights[l]))
-              refuse(method,
-                     "strategy \"line-sa\" needs a rectangular light (Ureña et al.'s "
-                     "spherical rectangle); light " +
-                         std::to_string(l) +
-                         " is a parallelogram whose edges are not perpendicular (to 1e-6 "
-                         "relative): use line-area");
-        }
-        break;
-      case StrategyKind::LineBd16:
-        // Billen & Dutré's analytic lines: an estimate per line, no point pdf (no MIS).
-        if (method.terms.size() > 1 && method.combine != Combine::Avg)
-          refuse(method,
-                 "strategy \"line-bd16\" integrates each line analytically and has no "
-                 "pdf at a point, so it cannot be combined by \"" +
-                     std::string(combine_name(method.combine)) + "\": use it alone or with /avg");
-        for (size_t l = 0; l < scene.lights.size(); ++l)
-          for (const Material& material : scene.materials)
-            if (auto why = Bd16LineSampler::unsupported(scene.lights[l], material))
-              refuse(method, "strategy \"line-bd16\" cannot shade light " + std::to_string(l) +
-                                 " on material \"" + material.name + "\": " + *why);
-        break;
-    }
-  }
-  switch (method.combine) {
-    case Combine::Balance:
-    case Combine::Power:
-    case Combine::Avg:
-      break;
-    case Combine::Smooth:
-    case Combine::SmoothFixed:
-      refuse_non_quads("combination \"" + std::string(combine_name(method.combine)) + "\"",
-                       "smooths the BSDF pdf over a quad's (u, v) (Salesin & Jarosz Eq. 23)");
-      break;
-    case Combine::Weighted:
-    case Combine::ClampedOptimal: {
-      // Peters' heuristics weight a diffuse (psa) and a specular (ltc) technique by their
-      // unshadowed integrals: exactly one term of each.
-      std::string name(combine_name(method.combine));
-      bool one_psa_one_ltc =
-          method.terms.size() == 2 && method.terms[0].strategy != method.terms[1].strategy;
-      for (const MethodTerm& term : method.terms)
-        if (term.strategy != StrategyKind::ProjectedSolidAngle &&
-            term.strategy != StrategyKind::Ltc)
-          one_psa_one_ltc = false;
-      if (!one_psa_one_ltc)
-        refuse(method, "combination \"" + name +
-                           "\" (Peters 2021 Sec. 4.2-4.3) combines one psa term and one ltc term, "
-                           "e.g. \"psa+ltc/" +
-                           name + "\" or \"2*psa+ltc/" + name + "\"");
-      for (size_t l = 0; l < scene.lights.size(); ++l)
-        if (scene.lights[l].type == LightType::Disk)
-          refuse(method, "combination \"" + name +
-                             "\" needs polygon or quad lights (psa and ltc sample polygons); "
-                             "light " +
-                             std::to_string(l) + " is a disk");
-      break;
-    }
-  }
+  check_method_runs_on(scene, method);
 }
 
 bool DirectLighting::needs_line_query() const {
@@ -521,8 +392,7 @@ std::vector<double> DirectLighting::weights(const ShadingPoint& sp, int light_in
   const Light& light = scene_->lights[light_index];
   size_t terms = method_.terms.size();
   PreparedTerms prepared;
-  for (size_t k = 0; k < terms; ++k)
-    prepared.emplace_back(prepare(method_.terms[k], sp, light, query));
+  for (size_t k = 0; k < terms; ++k) prepared.prepare(method_.terms[k], sp, light, query);
   LightLines lines = prepare_light_lines(method_, sp, light);
   std::vector<double> out(terms);
   if (peters_combination(method_.combine)) {
@@ -576,8 +446,7 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
 
     // Prepare every term's strategy once for this shading point and light.
     PreparedTerms prepared;
-    for (size_t k = 0; k < term_count; ++k)
-      prepared.emplace_back(prepare(method_.terms[k], sp, light, query));
+    for (size_t k = 0; k < term_count; ++k) prepared.prepare(method_.terms[k], sp, light, query);
     LightLines lines = prepare_light_lines(method_, sp, light);
     const bool peters = peters_combination(method_.combine);
     PetersTerms peters_terms;
@@ -591,9 +460,9 @@ Rgb DirectLighting::estimate(const ShadingPoint& sp, const Visibility& visibilit
       const int n = term.count * multiplier;
       StreamKey stream = key;
       stream.stream = light_term_stream(int(l), int(i));
-      if (term.strategy == StrategyKind::LineBd16) {
-        light_sum += bd16_estimate(sp, light, term, *query, pattern, stream, n,
-                                   term_count > 1 ? 1.0 / double(term_count) : 1.0);
+      if (strategy_info(term.strategy).family == StrategyFamily::AnalyticLine) {
+        light_sum += analytic_line_estimate(prepared[i], *query, pattern, stream, n,
+                                            average_weight(term_count));
         continue;
       }
       samples.resize(n);

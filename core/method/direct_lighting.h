@@ -4,19 +4,12 @@
 // contribution f * G * V * Le / p is weighted by the method's combination, and the lights' sums
 // add up (Salesin & Jarosz Eq. 1-2; Veach's multi-sample MIS with counts n_i).
 //
-// Combinations (weights of a sample x drawn by term i; n_k = count of term k, p_k its area pdf):
-//   balance  w_i = n_i p_i / sum_k n_k p_k
-//   power    w_i = (n_i p_i)^2 / sum_k (n_k p_k)^2            (Veach's beta = 2)
-//   avg      w_i = 1 / T                                        (plain average of the T estimates)
-//   smooth-fixed, smooth: balance with the BSDF terms' pdfs eased to 0 at the light's edges
-//            (and, for smooth, at occluder edges found by the method's line terms): Salesin &
-//            Jarosz Eq. 22-24, core/method/smoothing.h. Quad lights only.
-//   weighted, clamped-optimal: Peters 2021 Sec. 4.2-4.3 for exactly one psa and one ltc term
-//            (`psa+ltc/weighted`, `2*psa+ltc/clamped-optimal`; polygon and quad lights): per
-//            colour channel w_j = c_j p_j / sum_k c_k p_k with c_j the unshadowed integrals of
-//            the shading point and light (core/polygon/ltc_unshadowed_shading.h), and its blend
-//            with balance (v = 1/2); core/polygon/peters_mis.h. weights() reports the mean of
-//            the three channels' weights.
+// Combinations: the weights of a sample drawn by term i are the free functions of
+// core/method/combination.h (balance, power, avg, the smoothed balance of smooth and
+// smooth-fixed with the factor of core/method/smoothing.h, and Peters' weighted and
+// clamped-optimal for exactly one psa and one ltc term, per colour channel; weights() reports
+// the mean of the three channels' weights for those). Which methods can run on a scene:
+// core/method/method_check.h.
 //
 // Line terms (`line-area`, `line-sa` with direction u or v; core/lines/line_sampling_*.h) need
 // the Visibility's line query: their own samples are visible by construction (no shadow ray), and
@@ -35,9 +28,8 @@ namespace penumbra {
 
 class DirectLighting {
  public:
-  // Throws FormatError (path "method") when a term or combination cannot run on this scene:
-  // not available yet, or not defined for a light or material of the scene (the message names
-  // the strategy, the light or material, and why).
+  // Throws FormatError (path "method") when the method cannot run on this scene
+  // (check_method_runs_on, core/method/method_check.h).
   DirectLighting(const Scene& scene, const MethodSpec& method);
 
   // Reflected radiance towards sp.wo. `key` identifies the shading point's random streams (its

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <charconv>
+#include <optional>
 #include <utility>
 
 #include "core/scene/scene.h"
@@ -10,16 +11,6 @@ namespace penumbra {
 
 namespace {
 
-constexpr std::array<std::pair<std::string_view, StrategyKind>, 8> kStrategies{{
-    {"bsdf", StrategyKind::Bsdf},
-    {"area", StrategyKind::Area},
-    {"sa", StrategyKind::SolidAngle},
-    {"psa", StrategyKind::ProjectedSolidAngle},
-    {"ltc", StrategyKind::Ltc},
-    {"line-area", StrategyKind::LineArea},
-    {"line-sa", StrategyKind::LineSolidAngle},
-    {"line-bd16", StrategyKind::LineBd16},
-}};
 constexpr std::array<std::pair<std::string_view, Combine>, 7> kCombines{{
     {"balance", Combine::Balance},
     {"power", Combine::Power},
@@ -41,6 +32,16 @@ std::string alternatives(const Table& table) {
   for (const auto& [name, value] : table) {
     if (!out.empty()) out.append(", ");
     out.append(name);
+  }
+  return out;
+}
+
+// The registry's strategy names, for messages.
+std::string strategy_alternatives() {
+  std::string out;
+  for (const StrategyInfo& info : registered_strategy_infos()) {
+    if (!out.empty()) out.append(", ");
+    out.append(info.name);
   }
   return out;
 }
@@ -125,14 +126,14 @@ class MethodParser {
     }
     size_t word_start = pos_;
     std::string_view word = read_word();
-    if (word.empty()) fail("expected a strategy (" + alternatives(kStrategies) + ")");
-    const auto* entry = lookup(kStrategies, word);
-    if (!entry) {
+    if (word.empty()) fail("expected a strategy (" + strategy_alternatives() + ")");
+    std::optional<StrategyId> strategy = find_strategy(word);
+    if (!strategy) {
       pos_ = word_start;
       fail("unknown strategy \"" + excerpt(word) + "\"; expected one of " +
-           alternatives(kStrategies));
+           strategy_alternatives());
     }
-    term.strategy = entry->second;
+    term.strategy = *strategy;
     if (peek() == ':') {
       ++pos_;
       if (!is_line_strategy(term.strategy))
@@ -158,16 +159,6 @@ int MethodSpec::total_samples() const {
   return total;
 }
 
-bool is_line_strategy(StrategyKind kind) {
-  return kind == StrategyKind::LineArea || kind == StrategyKind::LineSolidAngle ||
-         kind == StrategyKind::LineBd16;
-}
-
-std::string_view strategy_name(StrategyKind kind) {
-  for (const auto& [name, value] : kStrategies)
-    if (value == kind) return name;
-  return "?";
-}
 std::string_view combine_name(Combine combine) {
   for (const auto& [name, value] : kCombines)
     if (value == combine) return name;

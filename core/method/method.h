@@ -4,6 +4,7 @@
 //   METHOD    := TERM ( "+" TERM )* [ "/" COMBINE ]
 //   TERM      := [ COUNT "*" ] STRATEGY [ ":" DIR ]
 //   STRATEGY  := bsdf | area | sa | psa | ltc | line-area | line-sa | line-bd16
+//                (the names of the strategy registry, core/strategies/registry.h)
 //   DIR       := u | v | rand          (line strategies only; default u)
 //   COMBINE   := balance | power | avg | smooth | smooth-fixed | weighted | clamped-optimal
 
@@ -11,24 +12,15 @@
 #include <string_view>
 #include <vector>
 
+#include "core/strategies/registry.h"
+
 namespace penumbra {
 
-enum class StrategyKind {
-  Bsdf,
-  Area,
-  SolidAngle,
-  ProjectedSolidAngle,
-  Ltc,
-  LineArea,
-  LineSolidAngle,
-  LineBd16
-};
-enum class LineDirection { U, V, Rand };
 enum class Combine { Balance, Power, Avg, Smooth, SmoothFixed, Weighted, ClampedOptimal };
 
 struct MethodTerm {
   int count = 1;
-  StrategyKind strategy = StrategyKind::SolidAngle;
+  StrategyId strategy = 0;  // a row of the strategy registry (core/strategies/registry.h)
   LineDirection direction = LineDirection::U;  // meaningful for line strategies only
   bool operator==(const MethodTerm&) const = default;
 };
@@ -44,8 +36,6 @@ inline constexpr int kMaxTermCount = 4096;      // COUNT of one term
 inline constexpr int kMaxMethodSamples = 4096;  // sum of COUNT over the terms
 inline constexpr int kMaxMethodTerms = 16;
 
-bool is_line_strategy(StrategyKind kind);
-std::string_view strategy_name(StrategyKind kind);
 std::string_view combine_name(Combine combine);
 std::string_view direction_name(LineDirection direction);
 

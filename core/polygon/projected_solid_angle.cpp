@@ -5,6 +5,8 @@
 #include <limits>
 #include <optional>
 
+#include "core/math/horizon_clip.h"
+
 namespace penumbra {
 
 namespace {
@@ -143,20 +145,8 @@ double ellipse_one_minus_radius_squared(const EdgeEllipse& e, const Vec2& w) {
 }
 
 int clip_polygon_to_upper_hemisphere(std::span<const Vec3> vertices, std::span<Vec3> out) {
-  int n = static_cast<int>(vertices.size());
-  int count = 0;
-  for (int i = 0; i < n; ++i) {
-    const Vec3& a = vertices[i];
-    const Vec3& b = vertices[(i + 1) % n];
-    if (a.z >= 0) out[count++] = a;
-    // Strict crossings only: a vertex on the horizon is kept once, as itself.
-    if ((a.z > 0 && b.z < 0) || (a.z < 0 && b.z > 0)) {
-      double t = a.z / (a.z - b.z);
-      Vec3 p = a + (b - a) * t;
-      p.z = 0;
-      out[count++] = p;
-    }
-  }
+  // Strict crossings only: a vertex on the horizon is kept once, as itself.
+  int count = int(clip_polygon_to_horizon(vertices, Vec3{0, 0, 1}, out));
   return count < 3 ? 0 : count;
 }
 
@@ -326,9 +316,8 @@ double ProjectedSolidAngleSampler::area_up_to(const Sector& s, const Vec2& w) co
   // |c|, where |m|^2 ~ 1 and the m form cancels), else from the m's (the form above); each is
   // used where its rounding error, eps max(|c|) or eps max(|m|^2) / (|c_o| + |c_i|), is smaller.
   double mi2 = dot2(i.m, i.m), mo2 = dot2(o.m, o.m);
-  double c_difference = std::max(co, ci) * (co + ci) < std::max(mi2, mo2)
-                            ? co - ci
-                            : (mi2 - mo2) / (co + ci);
+  double c_difference =
+      std::max(co, ci) * (co + ci) < std::max(mi2, mo2) ? co - ci : (mi2 - mo2) / (co + ci);
   double mi = dot2(i.m, s.s0) * dot2(i.m, w), mo = dot2(o.m, s.s0) * dot2(o.m, w);
   // |c_o| x_i - |c_i| x_o, the factor of sin(alpha_o - alpha_i) besides cross(s0, w).
   double mixed = -co * ci * c_difference * dot2(s.s0, w) + co * mi - ci * mo;

@@ -12,12 +12,18 @@ void report_embree_error(void*, RTCError code, const char* message) {
   // Errors during build surface through rtcGetDeviceError below; keep this quiet.
   (void)message;
 }
+// Embree's memory monitor: called with each allocation (bytes > 0) and release (bytes < 0).
+bool count_embree_bytes(void* counter, ssize_t bytes, bool) {
+  static_cast<std::atomic<int64_t>*>(counter)->fetch_add(int64_t(bytes));
+  return true;  // never refuse an allocation
+}
 }  // namespace
 
 EmbreeScene::EmbreeScene(const Scene& scene) : source_(&scene) {
   device_ = rtcNewDevice("threads=1,set_affinity=0");
   if (!device_) throw std::runtime_error("Embree: cannot create a device");
   rtcSetDeviceErrorFunction(device_, report_embree_error, nullptr);
+  rtcSetDeviceMemoryMonitorFunction(device_, count_embree_bytes, &memory_bytes_);
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
 
@@ -90,6 +96,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3& origin, const Vec3&
   const Vec3& p1 = source_->positions[tri[1]];
   const Vec3& p2 = source_->positions[tri[2]];
   double u = rayhit.hit.u, v = rayhit.hit.v;
+  hit.barycentric = {u, v};
   hit.position = p0 * (1 - u - v) + p1 * u + p2 * v;
   Vec3 n = cross(p1 - p0, p2 - p0);
   double len = length(n);

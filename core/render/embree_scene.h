@@ -11,6 +11,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
 #include <optional>
 
 #include "core/math/vec.h"
@@ -23,6 +26,7 @@ struct SurfaceHit {
   Vec3 position;
   Vec3 geometric_normal;  // unit, not yet flipped
   uint32_t triangle = 0;
+  Vec2 barycentric;  // weights of the triangle's vertices 1 and 2
 };
 
 class EmbreeScene {
@@ -44,11 +48,15 @@ class EmbreeScene {
   // Offset used for ray origins: scene-scale relative.
   double ray_epsilon() const { return ray_epsilon_; }
 
+  // Bytes Embree holds for this scene (BVH and buffers), as its memory monitor reports them.
+  size_t memory_bytes() const { return size_t(std::max<int64_t>(0, memory_bytes_.load())); }
+
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   const Scene* source_;
   double ray_epsilon_ = 1e-4;
+  std::atomic<int64_t> memory_bytes_{0};
 };
 
 }  // namespace penumbra

@@ -38,14 +38,21 @@ ImageMetadata render_metadata(const Scene& scene, const RenderOptions& options, 
   std::ostringstream seconds;
   seconds.precision(6);
   seconds << compute_seconds;
-  return {{"penumbra:method", options.method},
-          {"penumbra:sampler", std::string(pattern_name(options.sampler))},
-          {"penumbra:spp", std::to_string(spp)},
-          {"penumbra:seed", std::to_string(options.seed)},
-          {"penumbra:compute_seconds", seconds.str()},
-          {"penumbra:scene", scene.name},
-          {"penumbra:scene_hash", scene.content_hash},
-          {"penumbra:version", kVersion}};
+  ImageMetadata metadata = {{"penumbra:method", options.method},
+                            {"penumbra:sampler", std::string(pattern_name(options.sampler))},
+                            {"penumbra:spp", std::to_string(spp)},
+                            {"penumbra:seed", std::to_string(options.seed)},
+                            {"penumbra:compute_seconds", seconds.str()},
+                            {"penumbra:scene", scene.name},
+                            {"penumbra:scene_hash", scene.content_hash},
+                            {"penumbra:version", kVersion}};
+  // What the scene reader ignored or approximated travels with the image.
+  if (!scene.warnings.empty()) {
+    std::string warnings;
+    for (const std::string& warning : scene.warnings) warnings += warning + "\n";
+    metadata["penumbra:warnings"] = warnings;
+  }
+  return metadata;
 }
 
 }  // namespace penumbra

@@ -3,6 +3,7 @@
 // compute-time budget is spent (stopping at a pass boundary, so every pixel has the same spp and
 // the image is unbiased). The farm renders the same passes of the same tiles.
 
+#include <atomic>
 #include <functional>
 
 #include "core/render/film.h"
@@ -22,12 +23,19 @@ struct LocalRenderResult {
   uint32_t spp = 0;
   double compute_seconds = 0;  // CPU seconds of all threads
   double wall_seconds = 0;
+  bool stopped = false;  // `stop` was set: fewer passes than the budget asked for
 };
 
 // Progress is called after every pass block with the passes done and compute seconds so far.
+// With `stop`, pass blocks last at most about kStoppableBlockSeconds of wall time (and at most a
+// tenth of an spp budget, so that progress moves), and once *stop is true the render ends at the
+// next block boundary: every pixel then has the same whole passes, an unbiased image of
+// result.spp samples, bit-identical to a render of that many passes.
+inline constexpr double kStoppableBlockSeconds = 0.5;
 LocalRenderResult render_local(const Renderer& renderer, const RenderBudget& budget, int threads,
                                int tile_size = 64,
-                               const std::function<void(uint32_t, double)>& progress = {});
+                               const std::function<void(uint32_t, double)>& progress = {},
+                               const std::atomic<bool>* stop = nullptr);
 
 // CPU time of the process (all threads), seconds.
 double process_cpu_seconds();

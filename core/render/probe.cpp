@@ -1,7 +1,9 @@
 #include "core/render/probe.h"
 
 #include <chrono>
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "core/render/camera.h"
 #include "core/render/shading.h"
@@ -70,16 +72,32 @@ ProbeSpec parse_probe(const std::string& text, const std::string& source) {
   return probe;
 }
 
-ProbeResult run_probe(std::shared_ptr<const Scene> scene, const ProbeSpec& probe,
-                      const std::string& method, Pattern sampler, std::span<const int> counts,
-                      int trials, uint64_t seed) {
-  if (trials < 2) throw FormatError("trials", "at least 2 trials are needed for a variance");
-  for (int n : counts)
-    if (n < 1 || n > 1 << 20) throw FormatError("samples", "sample counts must be in 1..2^20");
-  SceneShading shading(scene, parse_method(method));
+namespace {
+
+// The surface a probe point lies on: a triangle of `material` within a few ray epsilons of
+// `position` along the normal `n` (either side), whose geometric normal is parallel to `n`.
+std::optional<SceneShading::FirstHit> surface_under(const SceneShading& shading,
+                                                    const Material& material, const Vec3& position,
+                                                    const Vec3& n) {
+  const double reach = 16 * shading.embree().ray_epsilon();
+  for (double side : {1.0, -1.0}) {
+    Vec3 origin = position + n * (side * reach);
+    SceneShading::FirstHit hit = shading.first_hit(origin, n * -side);
+    if (!hit.shading_point || hit.shading_point->material != &material) continue;
+    if (length(hit.shading_point->position - position) > 2 * reach) continue;
+    if (std::abs(dot(hit.shading_point->normal, n)) < 1 - 1e-9) continue;
+    return hit;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::vector<SceneShading::FirstHit> resolve_probe_points(const SceneShading& shading,
+                                                         const ProbeSpec& probe) {
+  const Scene* scene = &shading.scene();
   CameraRays camera(scene->camera);
 
-  // Resolve every probe point to what its camera ray (or description) sees.
   std::vector<SceneShading::FirstHit> hits;
   for (size_t i = 0; i < probe.pixels.size(); ++i) {
     auto [x, y] = probe.pixels[i];
@@ -101,10 +119,40 @@ ProbeResult run_probe(std::shared_ptr<const Scene> scene, const ProbeSpec& probe
     Vec3 n = normalize(p.normal);
     sp.normal = dot(n, sp.wo) < 0 ? -n : n;
     sp.material = material;
-    hits.push_back({sp, {}});
+    SceneShading::FirstHit hit;
+    hit.shading_point = sp;
+    if (is_pbrt_material(material->type)) {
+      if (auto surface = surface_under(shading, *material, p.position, n)) {
+        // The point lies on a triangle of its material: the BSDF that triangle has there
+        // (textures at its uv, the finest MIP level, bump mapping, the mesh's shading frame).
+        hit.surface = surface->surface;
+        hit.shading_point->normal = dot(surface->shading_point->normal, sp.wo) < 0
+                                        ? -surface->shading_point->normal
+                                        : surface->shading_point->normal;
+      } else {
+        // Off the scene's geometry: the material's constant values (textures ignored).
+        hit.surface = make_pbrt_bsdf(*material, constant_material_values(material->params),
+                                     Frame::from_normal(n), n);
+      }
+      hit.shading_point->bsdf = &hit.surface;
+    }
+    hits.push_back(hit);
   }
 
+  return hits;
+}
+
+ProbeResult run_probe(std::shared_ptr<const Scene> scene, const ProbeSpec& probe,
+                      const std::string& method, Pattern sampler, std::span<const int> counts,
+                      int trials, uint64_t seed) {
+  if (trials < 2) throw FormatError("trials", "at least 2 trials are needed for a variance");
+  for (int n : counts)
+    if (n < 1 || n > 1 << 20) throw FormatError("samples", "sample counts must be in 1..2^20");
+  SceneShading shading(scene, parse_method(method));
+  const std::vector<SceneShading::FirstHit> hits = resolve_probe_points(shading, probe);
+
   ProbeResult result;
+  result.probe = probe;
   result.method = method;
   result.sampler = std::string(pattern_name(sampler));
   result.trials = trials;
@@ -141,6 +189,30 @@ ProbeResult run_probe(std::shared_ptr<const Scene> scene, const ProbeSpec& probe
   return result;
 }
 
+std::optional<double> variance_slope(const std::vector<ProbeRun>& runs, int channel) {
+  std::vector<std::pair<double, double>> xy;
+  for (const ProbeRun& run : runs) {
+    const double variance = run.variance[channel];
+    if (run.n > 0 && variance > 0 && std::isfinite(variance))
+      xy.emplace_back(std::log(double(run.n)), std::log(variance));
+  }
+  if (xy.size() < 2) return std::nullopt;
+  double mx = 0, my = 0;
+  for (const auto& [x, y] : xy) {
+    mx += x;
+    my += y;
+  }
+  mx /= double(xy.size());
+  my /= double(xy.size());
+  double sxx = 0, sxy = 0;
+  for (const auto& [x, y] : xy) {
+    sxx += (x - mx) * (x - mx);
+    sxy += (x - mx) * (y - my);
+  }
+  if (!(sxx > 0)) return std::nullopt;
+  return sxy / sxx;
+}
+
 std::string probe_result_json(const ProbeResult& result) {
   json doc;
   doc["format"] = "penumbra/probe-result@1";
@@ -151,6 +223,21 @@ std::string probe_result_json(const ProbeResult& result) {
   for (size_t i = 0; i < result.points.size(); ++i) {
     json point;
     point["index"] = i;
+    const size_t pixels = result.probe.pixels.size();
+    if (i < pixels) {
+      point["pixel"] = {result.probe.pixels[i].first, result.probe.pixels[i].second};
+    } else if (i - pixels < result.probe.points.size()) {
+      const ProbePointSpec& spec = result.probe.points[i - pixels];
+      point["position"] = {spec.position.x, spec.position.y, spec.position.z};
+      point["normal"] = {spec.normal.x, spec.normal.y, spec.normal.z};
+      point["wo"] = {spec.wo.x, spec.wo.y, spec.wo.z};
+      point["material"] = spec.material;
+    }
+    point["variance_slope"] = json::array();
+    for (int channel = 0; channel < 3; ++channel) {
+      std::optional<double> slope = variance_slope(result.points[i], channel);
+      point["variance_slope"].push_back(slope ? json(*slope) : json(nullptr));
+    }
     point["runs"] = json::array();
     for (const ProbeRun& run : result.points[i]) {
       point["runs"].push_back({{"n", run.n},

@@ -8,20 +8,29 @@
 #include <stdexcept>
 
 #include "core/render/camera.h"
+#include "core/render/pixel_filter.h"
 #include "core/render/shading.h"
 
 namespace penumbra {
 
 struct Renderer::Impl {
-  Impl(std::shared_ptr<const Scene> scene, const RenderOptions& options)
-      : options(options), shading(scene, parse_method(options.method)), camera(scene->camera) {}
+  Impl(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options)
+      : options(options),
+        shading(prepared, parse_method(options.method)),
+        camera(prepared->scene().camera),
+        filter(prepared->scene().camera.filter) {}
   RenderOptions options;
   SceneShading shading;
   CameraRays camera;
+  PixelFilterSampler filter;
 };
 
 Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderOptions& options)
-    : impl_(std::make_unique<Impl>(std::move(scene), options)) {}
+    : impl_(std::make_unique<Impl>(std::make_shared<const PreparedScene>(std::move(scene)),
+                                   options)) {}
+
+Renderer::Renderer(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(prepared), options)) {}
 
 Renderer::~Renderer() = default;
 
@@ -49,10 +58,24 @@ void Renderer::render_tile(const TileRect& tile, uint32_t pass_begin, uint32_t p
             for (uint32_t pass = pass_begin; pass < pass_end; ++pass) {
               key.pass = pass;
               key.stream = kPixelJitterStream;
-              double jx = random_uniform(key, 0, 0), jy = random_uniform(key, 0, 1);
-              Vec3 direction = impl_->camera.direction(x + jx, y + jy);
-              Rgb radiance = impl_->shading.radiance(impl_->camera.origin(), direction,
-                                                     impl_->options.sampler, key);
+              // The sample's place in the pixel, drawn from the pixel filter.
+              Vec2 offset =
+                  impl_->filter.position(random_uniform(key, 0, 0), random_uniform(key, 0, 1));
+              Vec3 direction = impl_->camera.direction(x + offset.x, y + offset.y);
+              const Vec3& origin = impl_->camera.origin();
+              RayDifferential differential;
+              bool with_differential = impl_->shading.wants_differentials();
+              if (with_differential) {
+                // The rays one pixel over, scaled as pbrt-v3's samplers scale them.
+                double scale = scene.texture_footprint_scale;
+                Vec3 dx = impl_->camera.direction(x + offset.x + 1, y + offset.y);
+                Vec3 dy = impl_->camera.direction(x + offset.x, y + offset.y + 1);
+                differential = {origin, direction + (dx - direction) * scale, origin,
+                                direction + (dy - direction) * scale};
+              }
+              Rgb radiance =
+                  impl_->shading.radiance(origin, direction, impl_->options.sampler, key, 1,
+                                          with_differential ? &differential : nullptr);
               out.add_sample(local, radiance);
             }
           }

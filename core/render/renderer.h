@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/render/prepared_scene.h"
 #include "core/render/tile.h"
 #include "core/sampling/pattern.h"
 #include "core/scene/scene.h"
@@ -28,6 +29,9 @@ class Renderer {
   // Builds the Embree scene and the line-query BVH. Throws FormatError for a method that cannot
   // run on this scene (unknown strategy, strategy not available yet, method/material mismatch).
   Renderer(std::shared_ptr<const Scene> scene, const RenderOptions& options);
+  // Over a prepared scene shared with other renderers (other methods, samplers, seeds): only
+  // the method's estimator is built here.
+  Renderer(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

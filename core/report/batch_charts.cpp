@@ -10,7 +10,7 @@ namespace penumbra {
 
 namespace {
 
-// Points grouped by x (mean x and y of each group, standard deviation of y as error bar).
+// Points grouped by x (mean x and y of each group, the 95% interval of the mean y as error bar).
 struct GroupedPoints {
   std::map<uint32_t, std::vector<double>> x, y;
   void add(uint32_t key, double x_value, double y_value) {
@@ -23,10 +23,10 @@ struct GroupedPoints {
     bool any_spread = false;
     for (const auto& [key, ys] : y) {
       series.x.push_back(mean_std(x.at(key)).mean);
-      MeanStd stats = mean_std(ys);
+      MeanInterval stats = mean_interval(ys);
       series.y.push_back(stats.mean);
-      series.y_error.push_back(stats.std);
-      any_spread = any_spread || stats.count > 1;
+      series.y_error.push_back(stats.half_width);
+      any_spread = any_spread || stats.has_interval;
     }
     if (!any_spread) series.y_error.clear();
     return series;
@@ -43,11 +43,17 @@ void add_fit(ChartSeries& series) {
 
 }  // namespace
 
-ChartSpec mrse_time_chart(const BatchResult& result, const RecomputedErrors& recomputed) {
+std::string ChartAnnotations::suffix(const std::string& label, const std::string& region) const {
+  auto it = legend_suffix.find({label, region});
+  return it == legend_suffix.end() ? "" : it->second;
+}
+
+ChartSpec mrse_time_chart(const BatchResult& result, const RecomputedErrors& recomputed,
+                          const ChartAnnotations& annotations) {
   ChartSpec spec;
   spec.title = "MRSE against compute time" + (result.name.empty() ? "" : ": " + result.name);
   spec.x_label = "compute seconds";
-  spec.y_label = "MRSE (full image)";
+  spec.y_label = "MRSE (full image)" + annotations.y_label_note;
   spec.log_x = spec.log_y = true;
   for (size_t m = 0; m < result.methods.size(); ++m) {
     const BatchMethod& method = result.methods[m];
@@ -62,7 +68,7 @@ ChartSpec mrse_time_chart(const BatchResult& result, const RecomputedErrors& rec
       for (const BatchCurvePoint& point : run.curve)
         points.add(point.passes, point.compute_seconds, point.mrse);
     }
-    ChartSeries series = points.series(method.label);
+    ChartSeries series = points.series(method.label + annotations.suffix(method.label, "image"));
     series.color = int(m);
     spec.series.push_back(std::move(series));
   }
@@ -70,12 +76,12 @@ ChartSpec mrse_time_chart(const BatchResult& result, const RecomputedErrors& rec
 }
 
 ChartSpec mrse_spp_chart(const BatchResult& result, const RecomputedErrors& recomputed,
-                         const std::string& region) {
+                         const std::string& region, const ChartAnnotations& annotations) {
   ChartSpec spec;
   spec.title =
       "MRSE against spp, " + (region == "image" ? std::string("full image") : "region " + region);
   spec.x_label = "samples per pixel";
-  spec.y_label = "MRSE (" + region + ")";
+  spec.y_label = "MRSE (" + region + ")" + annotations.y_label_note;
   spec.log_x = spec.log_y = true;
   for (size_t m = 0; m < result.methods.size(); ++m) {
     const BatchMethod& method = result.methods[m];
@@ -88,14 +94,22 @@ ChartSpec mrse_spp_chart(const BatchResult& result, const RecomputedErrors& reco
         for (const BatchCurvePoint& point : run.curve)
           points.add(point.passes, double(point.passes), point.mrse);
     }
+    // A region of a method with one spp level (an equal-time run): the farm measured no curve
+    // there, so each repeat is its own point (its spp and its error), not one mean.
+    const bool per_repeat = spp_levels.size() == 1 && points.y.empty();
     if (points.y.empty()) {
       for (size_t r = 0; r < method.runs.size(); ++r)
-        points.add(method.runs[r].spp, double(method.runs[r].spp),
+        points.add(per_repeat ? uint32_t(r) : method.runs[r].spp, double(method.runs[r].spp),
                    recomputed.at(m).at(r).at(region).mrse);
     }
-    ChartSeries series = points.series(method.label);
+    ChartSeries series = points.series(method.label + annotations.suffix(method.label, region));
     series.color = int(m);
-    add_fit(series);
+    if (per_repeat) {
+      series.lines = false;
+      series.y_error.clear();
+    } else {
+      add_fit(series);
+    }
     spec.series.push_back(std::move(series));
   }
   return spec;
@@ -114,16 +128,16 @@ std::string file_safe_name(const std::string& name) {
 std::vector<BatchChartFiles> write_batch_charts(const BatchResult& result,
                                                 const RecomputedErrors& recomputed,
                                                 const std::filesystem::path& chart_dir, int width,
-                                                int height) {
+                                                int height, const ChartAnnotations& annotations) {
   std::filesystem::create_directories(chart_dir);
   std::vector<std::pair<std::string, ChartSpec>> charts;
-  charts.emplace_back("mrse_time", mrse_time_chart(result, recomputed));
-  charts.emplace_back("mrse_spp_image", mrse_spp_chart(result, recomputed, "image"));
+  charts.emplace_back("mrse_time", mrse_time_chart(result, recomputed, annotations));
+  charts.emplace_back("mrse_spp_image", mrse_spp_chart(result, recomputed, "image", annotations));
   std::set<std::string> stems = {"mrse_time", "mrse_spp_image"};
   for (const BatchRegion& region : result.regions) {
     std::string stem = "mrse_spp_region_" + file_safe_name(region.name);
     while (!stems.insert(stem).second) stem += "_";
-    charts.emplace_back(stem, mrse_spp_chart(result, recomputed, region.name));
+    charts.emplace_back(stem, mrse_spp_chart(result, recomputed, region.name, annotations));
   }
   std::vector<BatchChartFiles> files;
   for (auto& [stem, spec] : charts) {

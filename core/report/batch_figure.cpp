@@ -1,14 +1,13 @@
 // The batch figure: layout in columns (reference, then each method), images resampled and
-// tonemapped into one OpenImageIO ImageBuf, labels drawn with render_text.
+// tonemapped onto one canvas of the image module (OpenImageIO), labels drawn with its text.
 
 #include "core/report/batch_figure.h"
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "core/image/oiio_services.h"
 
 namespace penumbra {
 
@@ -105,42 +104,35 @@ double percentile(std::vector<float> values, double fraction) {
 
 class Canvas {
  public:
-  Canvas(int width, int height)
-      : buffer_(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT)) {
-    OIIO::ImageBufAlgo::fill(buffer_, {1.0f, 1.0f, 1.0f});
-  }
+  Canvas(int width, int height) : canvas_(oiio::services().canvas(width, height)) {}
 
   void paste(const DisplayImage& image, int x, int y) {
-    OIIO::ImageBuf tile(OIIO::ImageSpec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT),
-                        const_cast<float*>(image.rgb.data()));
-    OIIO::ImageBufAlgo::paste(buffer_, x, y, 0, 0, tile);
+    canvas_->paste(image.rgb.data(), image.width, image.height, x, y);
   }
 
   // A rectangle outline `thickness` pixels wide inside [x0, x1] x [y0, y1].
   void outline(int x0, int y0, int x1, int y1, const float* color, int thickness) {
     for (int t = 0; t < thickness && x0 + t <= x1 - t && y0 + t <= y1 - t; ++t)
-      OIIO::ImageBufAlgo::render_box(buffer_, x0 + t, y0 + t, x1 - t, y1 - t, {color, 3}, false);
+      canvas_->box(x0 + t, y0 + t, x1 - t, y1 - t, color, false);
   }
 
   void fill(int x0, int y0, int x1, int y1, const float* color) {
-    OIIO::ImageBufAlgo::render_box(buffer_, x0, y0, x1, y1, {color, 3}, true);
+    canvas_->box(x0, y0, x1, y1, color, true);
   }
 
   // Text centred on `center_x` (or starting at it), shrunk until it fits in `max_width`.
   void text(int x, int baseline, const std::string& text, int size, bool bold, int max_width,
             bool centered = true) {
-    if (text.empty()) return;  // OIIO measures empty text as an undefined ROI
+    if (text.empty()) return;
     const char* font = bold ? kFontBold : kFontRegular;
     int width = 0;
     for (; size >= 8; --size) {
-      OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(text, size, font);
-      width = extent.defined() ? extent.width() : 0;
+      width = canvas_->text_width(text, size, font);
       if (width <= max_width) break;
     }
     float black[3] = {0.05f, 0.05f, 0.05f};
     int start = centered ? x - width / 2 : x;
-    OIIO::ImageBufAlgo::render_text(buffer_, start, baseline, text, std::max(size, 8), font,
-                                    {black, 3});
+    canvas_->text(start, baseline, text, std::max(size, 8), font, black);
   }
 
   // Text broken into centred lines at spaces, each at most `max_width` wide; at most
@@ -160,8 +152,8 @@ class Canvas {
     std::vector<std::string> lines;
     for (const std::string& next : words) {
       std::string candidate = lines.empty() ? next : lines.back() + " " + next;
-      OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(candidate, size, kFontRegular);
-      if (!lines.empty() && extent.defined() && extent.width() <= max_width)
+      int width = canvas_->text_width(candidate, size, kFontRegular);
+      if (!lines.empty() && width > 0 && width <= max_width)
         lines.back() = candidate;
       else
         lines.push_back(next);
@@ -175,12 +167,15 @@ class Canvas {
   }
 
   void write(const std::filesystem::path& path) {
-    if (!buffer_.write(path.string(), OIIO::TypeDesc::UINT8))
-      throw std::runtime_error(path.string() + ": cannot write the figure: " + buffer_.geterror());
+    try {
+      canvas_->write(path.string());
+    } catch (const std::runtime_error& error) {
+      throw std::runtime_error(path.string() + ": " + error.what());
+    }
   }
 
  private:
-  OIIO::ImageBuf buffer_;
+  std::unique_ptr<oiio::Canvas> canvas_;
 };
 
 // The run a method's column shows: its highest spp, lowest repeat.

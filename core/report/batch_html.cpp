@@ -4,6 +4,7 @@
 
 #include "core/report/batch_html.h"
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -38,6 +39,8 @@ table { border-collapse: collapse; font-size: 13px; }
 th, td { border: 1px solid #bbb; padding: 4px 8px; text-align: right; }
 th { background: #eee; } td.text { text-align: left; }
 td.best { background: #d8f5d0; font-weight: bold; }
+td.flagged { background: #fde7c8; } td.best.flagged { background: #e6efc0; }
+.small { font-size: 11px; color: #555; font-weight: normal; }
 td.refused { text-align: left; color: #a00; }
 .charts img { max-width: 680px; margin: 6px; border: 1px solid #ddd; }
 .figure img { max-width: 100%; border: 1px solid #ddd; }
@@ -46,33 +49,89 @@ pre { background: #f6f6f6; padding: 8px; font-size: 12px; overflow-x: auto; }
 .note { font-size: 12px; color: #444; }
 )";
 
-void write_table(std::ostringstream& out, const BatchTable& table) {
+std::string interval_text(const MeanInterval& value) {
+  std::string text = format_number(value.mean);
+  if (value.has_interval)
+    text += " [" + format_number(value.lower()) + ", " + format_number(value.upper()) + "]";
+  return text;
+}
+
+std::string percent(double share) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.0f%%", 100 * share);
+  return text;
+}
+
+void write_table(std::ostringstream& out, const BatchTable& table, const std::string& baseline) {
   out << "<table id=\"batch-table\">\n<tr><th>label</th><th>method</th><th>sampler</th>"
          "<th>group</th><th>spp</th><th>repeats</th><th>compute s</th>";
   for (const std::string& region : table.regions)
     out << "<th>MRSE " << html_escape(region == "image" ? "full image" : region) << "</th>";
-  out << "</tr>\n";
+  out << "<th>efficiency vs " << html_escape(baseline) << "</th></tr>\n";
   for (const BatchTableRow& row : table.rows) {
     out << "<tr><td class=\"text\">" << html_escape(row.label) << "</td><td class=\"text\">"
         << html_escape(row.method) << "</td><td class=\"text\">" << html_escape(row.sampler)
         << "</td>";
     if (!row.refusal.empty()) {
-      out << "<td class=\"refused\" colspan=\"" << 4 + table.regions.size()
+      out << "<td class=\"refused\" colspan=\"" << 5 + table.regions.size()
           << "\">refused: " << html_escape(row.refusal) << "</td></tr>\n";
       continue;
     }
     out << "<td class=\"text\">" << html_escape(row.comparison_group) << "</td><td>" << row.spp_min;
     if (row.spp_max != row.spp_min) out << "–" << row.spp_max;
-    out << "</td><td>" << row.repeats << "</td>";
-    auto cell = [&](const std::string& column, const std::string& text) {
-      bool best = row.best.count(column) > 0;
-      out << "<td" << (best ? " class=\"best\" title=\"best of its group\"" : "") << ">"
-          << html_escape(text) << (best ? " ★" : "") << "</td>";
-    };
-    cell("compute_seconds", mean_std_text(row.compute_seconds));
-    for (const std::string& region : table.regions)
-      cell("mrse:" + region, mean_std_text(row.mrse.at(region)));
-    out << "</tr>\n";
+    out << "</td><td>" << row.repeats << "</td><td>"
+        << html_escape(mean_std_text(row.compute_seconds)) << "</td>";
+    for (const std::string& region : table.regions) {
+      const bool best = row.best.count("mrse:" + region) > 0;
+      auto cell = row.cells.find(region);
+      if (cell == row.cells.end()) {
+        out << "<td>" << html_escape(mean_std_text(row.mrse.at(region))) << "</td>";
+        continue;
+      }
+      const BatchCell& value = cell->second;
+      std::string classes = std::string(best ? "best" : "") +
+                            (value.reference_flagged ? (best ? " flagged" : "flagged") : "");
+      // data-viewer-*: a click shows this method and region in the viewer.
+      out << "<td data-viewer-label=\"" << html_escape(row.label) << "\" data-viewer-region=\""
+          << html_escape(region) << "\"" << (classes.empty() ? "" : " class=\"" + classes + "\"")
+          << (best ? " title=\"beats every other row of its group at 95%\"" : "") << ">"
+          << html_escape(interval_text(value.corrected)) << (best ? " ★" : "")
+          << "<br><span class=\"small\">plain " << html_escape(format_number(value.plain.mean))
+          << " · ref " << percent(value.reference_share) << (value.reference_flagged ? " ⚠" : "")
+          << "</span></td>";
+    }
+    out << "<td>"
+        << (row.efficiency.count > 0 ? "×" + html_escape(interval_text(row.efficiency)) : "–")
+        << "</td></tr>\n";
+  }
+  out << "</table>\n";
+}
+
+void write_pairwise(std::ostringstream& out, const BatchTable& table,
+                    const BatchComparison& comparison) {
+  if (comparison.pairwise.empty()) return;
+  out << "<h2>Pairwise comparisons</h2>\n<p class=\"note\">For each group and region, every "
+         "pair of rows: the ratio of their mean corrected MRSE and whether the paired "
+         "difference over the repeats (same seed offsets, so repeat r of A and B share their "
+         "camera jitter) is significant at 95% (two-sided t test, k - 1 degrees of freedom); "
+         "the reference's noise is common to both and cancels.</p>\n"
+         "<table id=\"pairwise-table\">\n<tr><th>group</th><th>region</th><th>A</th><th>B</th>"
+         "<th>MRSE A / B</th><th>difference A - B [95%]</th><th>p</th><th>verdict</th></tr>\n";
+  for (const PairwiseComparison& pair : comparison.pairwise) {
+    const std::string& a = table.rows[pair.row_a].label;
+    const std::string& b = table.rows[pair.row_b].label;
+    std::string verdict = pair.difference.pairs < 2  ? "one repeat: not tested"
+                          : pair.difference.sign < 0 ? a + " beats " + b
+                          : pair.difference.sign > 0 ? b + " beats " + a
+                                                     : "not significant";
+    out << "<tr><td class=\"text\">" << html_escape(pair.group) << "</td><td class=\"text\">"
+        << html_escape(pair.region) << "</td><td class=\"text\">" << html_escape(a)
+        << "</td><td class=\"text\">" << html_escape(b) << "</td><td>"
+        << html_escape(format_number(pair.ratio)) << "</td><td>"
+        << html_escape(format_number(pair.difference.difference)) << " ± "
+        << html_escape(format_number(pair.difference.half_width)) << "</td><td>"
+        << html_escape(format_number(pair.difference.p_value)) << "</td><td class=\"text\">"
+        << html_escape(verdict) << "</td></tr>\n";
   }
   out << "</table>\n";
 }
@@ -148,13 +207,27 @@ std::string batch_report_html(const BatchReportContent& content) {
     out << "</ul>\n";
   }
 
-  out << "<h2>Table</h2>\n<p class=\"note\">MRSE (Salesin &amp; Jarosz; mean over pixels and "
-         "channels of (p - r)² / (r² + 1e-6)) recomputed from the EXRs against the reference; mean "
-         "± "
-         "sample standard deviation over repeats. ★ marks the lowest value of each column among "
-         "the rows of one group (the same time budget, or the same spp). Also as "
-      << "<a href=\"table.csv\">table.csv</a> and <a href=\"table.json\">table.json</a>.</p>\n";
-  write_table(out, *content.table);
+  const std::string baseline = content.comparison ? content.comparison->baseline : "";
+  out << "<h2>Table</h2>\n<p class=\"note\">How to read it. Each MRSE cell (Salesin &amp; "
+         "Jarosz: mean over pixels and channels of (p - r)² / (r² + 1e-6), recomputed from the "
+         "EXRs) is the <b>corrected</b> MRSE: the reference's own expected contribution, the mean "
+         "of s² / (r² + 1e-6) with s² the reference's per-pixel variance of the mean (its EXR's "
+         "variance layer), removed. It is the mean over the repeats with its 95% interval in "
+         "brackets (the repeats' spread and the reference's own noise, which every run shares). "
+         "Below it: the <b>plain</b> MRSE as measured, and the reference's <b>share</b> of it; a "
+         "share above "
+      << percent(kReferenceShareFlag)
+      << " is flagged ⚠ (orange): there the reference is not clean enough for the plain number "
+         "to mean much, and the corrected one leans on the correction. ★ marks a row that beats "
+         "every other row of its group (the same time budget, or the same spp) in that column at "
+         "95%, paired by repeat; no star means no significant winner. Efficiency is 1 / (MRSE × "
+         "compute seconds) relative to <b>"
+      << html_escape(baseline)
+      << "</b> (paired by repeat, image MRSE corrected): above 1 is better. Also as <a "
+         "href=\"table.csv\">table.csv</a> and <a href=\"table.json\">table.json</a>.</p>\n";
+  write_table(out, *content.table, baseline);
+  out << content.viewer_html;
+  if (content.comparison) write_pairwise(out, *content.table, *content.comparison);
 
   std::vector<const BatchMethod*> refused;
   for (const BatchMethod& method : result.methods)
@@ -198,6 +271,17 @@ std::string batch_report_html(const BatchReportContent& content) {
   detail("spp", std::to_string(result.reference.spp));
   detail("job", result.reference.job_id);
   detail("cached", result.reference.cached ? "yes (rendered by an earlier batch)" : "no");
+  if (content.reference_noise) {
+    const ReferenceNoise& noise = *content.reference_noise;
+    if (!noise.has_variance) {
+      detail("own noise", "unknown: the reference EXR has no variance layer (nothing corrected)");
+    } else {
+      for (const auto& [region, error] : noise.regions)
+        detail("own MRSE, " + region, format_number(error.reference_term) + " (± " +
+                                          format_number(error.reference_deviation) +
+                                          " shared by every run)");
+    }
+  }
   out << "</table>\n";
 
   out << "<h2>Runs</h2>\n<table>\n<tr><th>label</th><th>budget s</th><th>repeat</th><th>seed</th>"

@@ -26,6 +26,10 @@ struct BatchReportOptions {
   bool allow_error_mismatch = false;
   // Chart size (pixels for PNG, points for SVG).
   int chart_width = 800, chart_height = 560;
+  // Measure every run against this EXR instead of the folder's reference (e.g. a deeper one, to
+  // check the table): the recorded errors are then not checked, and the page says so (the farm's
+  // MRSE curves stay measured against the folder's reference).
+  std::filesystem::path reference_exr;
 };
 
 // Reads the batch result folder `result_dir` and writes into `out_dir` (created if needed):

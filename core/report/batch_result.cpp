@@ -4,6 +4,7 @@
 #include "core/report/batch_result.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -266,6 +267,28 @@ BatchResult read_batch_result(const std::filesystem::path& result_dir) {
       check_file(result.methods[i].runs[r].exr,
                  "methods[" + std::to_string(i) + "].runs[" + std::to_string(r) + "].exr");
   return result;
+}
+
+std::string reference_depth_warning(const BatchResult& result) {
+  const BatchReference& reference = result.reference;
+  // An exact reference's spp counts camera samples of closed-form shading, not noisy passes.
+  if (reference.spp == 0 || reference.method.rfind("exact", 0) == 0) return "";
+  uint32_t deepest = 0;
+  std::string label;
+  for (const BatchMethod& method : result.methods)
+    for (const BatchRun& run : method.runs)
+      if (run.spp > deepest) {
+        deepest = run.spp;
+        label = method.label;
+      }
+  if (deepest == 0 || double(reference.spp) >= kReferenceSppFactor * deepest) return "";
+  char ratio[32];
+  std::snprintf(ratio, sizeof ratio, "%.2g", double(reference.spp) / deepest);
+  return "the reference has " + std::to_string(reference.spp) + " spp, only " + ratio + "x the " +
+         std::to_string(deepest) + " spp of " + label +
+         "'s runs: it is barely cleaner than what it judges, and its noise is a large part of "
+         "every error (give the reference " +
+         std::to_string(uint32_t(kReferenceSppFactor) * deepest) + " spp or more)";
 }
 
 }  // namespace penumbra

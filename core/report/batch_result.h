@@ -99,6 +99,13 @@ struct BatchResult {
 BatchResult parse_batch_result(const std::string& json_text,
                                const std::string& source = "batch.json");
 
+// A reference rendered with fewer than kReferenceSppFactor times the spp of the deepest run it
+// judges is barely cleaner than that run: its own noise is a large part of every error measured
+// against it. The warning to print (empty when the reference is deep enough, is not a rendered
+// one, or its spp is unknown).
+inline constexpr double kReferenceSppFactor = 4;
+std::string reference_depth_warning(const BatchResult& result);
+
 // Reads DIR/batch.json and checks that every EXR it names exists in DIR (a missing file is an
 // error naming the key path and the file). Throws BatchResultError.
 BatchResult read_batch_result(const std::filesystem::path& result_dir);

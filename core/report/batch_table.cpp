@@ -168,7 +168,6 @@ BatchTable make_batch_table(const BatchResult& result, const RecomputedErrors& r
       for (BatchTableRow* row : rows)
         if (value_of(*row) == best) row->best.insert(column);
     };
-    mark("compute_seconds", [](const BatchTableRow& row) { return row.compute_seconds.mean; });
     for (const std::string& region : table.regions)
       mark("mrse:" + region, [&](const BatchTableRow& row) { return row.mrse.at(region).mean; });
   }
@@ -182,6 +181,13 @@ std::string batch_table_csv(const BatchTable& table) {
   for (const std::string& region : table.regions)
     out << "," << csv_field("mrse_" + region + "_mean") << ","
         << csv_field("mrse_" + region + "_std");
+  // The comparison's columns (core/report/batch_comparison.h): corrected MRSE with its 95%
+  // interval and the reference's share, per region; the efficiency against the baseline.
+  for (const std::string& region : table.regions)
+    for (const char* part :
+         {"_corrected_mean", "_corrected_lower", "_corrected_upper", "_reference_share"})
+      out << "," << csv_field("mrse_" + region + part);
+  out << ",efficiency_mean,efficiency_lower,efficiency_upper";
   out << ",best,refusal\n";
   for (const BatchTableRow& row : table.rows) {
     out << csv_field(row.label) << "," << csv_field(row.method) << "," << csv_field(row.sampler)
@@ -193,9 +199,28 @@ std::string batch_table_csv(const BatchTable& table) {
       for (const std::string& region : table.regions)
         out << "," << exact_number(row.mrse.at(region).mean) << ","
             << exact_number(row.mrse.at(region).std);
+      auto interval = [&](const MeanInterval& value) {
+        out << "," << exact_number(value.mean) << ","
+            << (value.has_interval ? exact_number(value.lower()) : "") << ","
+            << (value.has_interval ? exact_number(value.upper()) : "");
+      };
+      for (const std::string& region : table.regions) {
+        auto cell = row.cells.find(region);
+        if (cell == row.cells.end()) {
+          out << ",,,,";
+          continue;
+        }
+        interval(cell->second.corrected);
+        out << "," << exact_number(cell->second.reference_share);
+      }
+      if (row.efficiency.count > 0)
+        interval(row.efficiency);
+      else
+        out << ",,,";
     } else {
       out << ",,,,";
-      for (size_t i = 0; i < table.regions.size(); ++i) out << ",,";
+      for (size_t i = 0; i < table.regions.size(); ++i) out << ",,,,,,";
+      out << ",,,";
     }
     std::string best;
     for (const std::string& column : row.best) best += (best.empty() ? "" : ";") + column;

@@ -14,6 +14,7 @@
 
 #include "core/image/metrics.h"
 #include "core/report/batch_result.h"
+#include "core/report/significance.h"
 
 namespace penumbra {
 
@@ -39,6 +40,15 @@ struct MeanStd {
 };
 MeanStd mean_std(const std::vector<double>& values);
 
+// One region of one row, filled by compare_batch_rows (core/report/batch_comparison.h).
+struct BatchCell {
+  MeanInterval corrected;          // noise-corrected MRSE over the repeats, 95% interval with the
+                                   // reference's shared deviation
+  MeanInterval plain;              // the MRSE as measured (interval from the repeats' spread alone)
+  double reference_share = 0;      // mean over the runs of the reference's term / plain MRSE
+  bool reference_flagged = false;  // reference_share > kReferenceShareFlag
+};
+
 struct BatchTableRow {
   std::string label, method, sampler;
   std::optional<double> budget_seconds;
@@ -49,9 +59,14 @@ struct BatchTableRow {
   std::map<std::string, MeanStd> mrse;  // "image" and every region
   // Rows compared with each other for "best": the same budget, or the same spp.
   std::string comparison_group;
-  // Columns where this row is the best of its group ("compute_seconds", "mrse:image",
-  // "mrse:<region>"); only in groups of two or more rows.
+  // Columns where this row is the best of its group ("mrse:image", "mrse:<region>"); only in
+  // groups of two or more rows. make_batch_table marks the lowest mean; compare_batch_rows
+  // keeps only the rows that beat every other row of the group at 95%.
   std::set<std::string> best;
+  std::map<std::string, BatchCell> cells;  // "image" and every region (compare_batch_rows)
+  // 1 / (MRSE x compute seconds) relative to the baseline's (paired by repeat, image MRSE
+  // corrected); count 0 when not measured (no baseline row in the group, an MRSE <= 0).
+  MeanInterval efficiency;
   // The runs of the row: indices into the method's runs.
   size_t method_index = 0;
   std::vector<size_t> run_indices;

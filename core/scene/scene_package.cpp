@@ -54,6 +54,12 @@ class Sha256 {
 
 }  // namespace
 
+std::string sha256_hex(std::string_view bytes) {
+  Sha256 hash;
+  hash.update(bytes);
+  return hash.hex_digest();
+}
+
 std::string scene_content_hash(std::string_view scene_json,
                                const std::vector<std::pair<std::string, std::string>>& obj_files) {
   Sha256 hash;

@@ -37,6 +37,9 @@ ScenePackage collect_scene_package(const std::string& path, const SceneLimits& l
 // the scene does not name are ignored and do not enter the hash. Throws FormatError.
 Scene parse_scene_package(const ScenePackage& package, const SceneLimits& limits = {});
 
+// SHA-256 of `bytes` as 64 lowercase hex digits.
+std::string sha256_hex(std::string_view bytes);
+
 // SHA-256 hex of the canonical byte string described above.
 std::string scene_content_hash(std::string_view scene_json,
                                const std::vector<std::pair<std::string, std::string>>& obj_files);

@@ -10,6 +10,7 @@
 
 #include "core/scene/json_node.h"
 #include "core/scene/light_setup.h"
+#include "core/scene/pbrt_scene_builder.h"
 #include "core/scene/scene_package.h"
 #include "core/scene/scene_path.h"
 #include "core/scene/shape_mesh.h"
@@ -226,36 +227,18 @@ class SceneParser {
                  ", past the limit max_triangles = " + std::to_string(limits_.max_triangles));
   }
 
-  // Appends a mesh to the scene's flat arrays, dropping triangles of exactly zero area (they
-  // occlude nothing and would only burden the ray and line queries).
+  // Appends a mesh to the scene's flat arrays (append_mesh_to_scene: zero-area triangles
+  // dropped with a warning).
   void append_mesh(const TriangleMesh& mesh, uint32_t material, const JsonNode& shape) {
-    check_triangle_budget(shape, mesh.triangle_count());
-    for (const Vec3& p : mesh.positions)
-      for (int axis = 0; axis < 3; ++axis)
-        if (!(std::abs(p[axis]) <= limits_.max_coordinate))
-          shape.fail("a vertex coordinate " + number_text(p[axis]) +
-                     " exceeds the limit max_coordinate = " + number_text(limits_.max_coordinate));
-    Scene& s = scene();
-    if (s.positions.size() + mesh.positions.size() > std::numeric_limits<uint32_t>::max())
-      shape.fail("too many vertices for 32-bit indices");
-    const auto base = static_cast<uint32_t>(s.positions.size());
     size_t dropped = 0;
-    s.positions.insert(s.positions.end(), mesh.positions.begin(), mesh.positions.end());
-    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-      const Vec3& a = mesh.positions[mesh.indices[t]];
-      const Vec3& b = mesh.positions[mesh.indices[t + 1]];
-      const Vec3& c = mesh.positions[mesh.indices[t + 2]];
-      if (length_squared(cross(b - a, c - a)) == 0) {
-        ++dropped;
-        continue;
-      }
-      s.indices.insert(s.indices.end(), {base + mesh.indices[t], base + mesh.indices[t + 1],
-                                         base + mesh.indices[t + 2]});
-      s.triangle_materials.push_back(material);
+    try {
+      dropped = append_mesh_to_scene(scene(), mesh, material, limits_);
+    } catch (const std::invalid_argument& error) {
+      shape.fail(error.what());
     }
     if (dropped > 0)
-      s.warnings.push_back(shape.path() + ": dropped " + std::to_string(dropped) +
-                           " zero-area triangle(s)");
+      scene().warnings.push_back(shape.path() + ": dropped " + std::to_string(dropped) +
+                                 " zero-area triangle(s)");
   }
 
   void parse_shapes(const JsonNode& node) {
@@ -503,6 +486,10 @@ class SceneParser {
 
 ParsedScene parse_scene_with_reader(const std::string& json_text, const ObjFileReader& read_obj,
                                     const std::string& source, const SceneLimits& limits) {
+  // A pbrt-v3 file by its extension, or by its content when the name says neither.
+  std::string extension = std::filesystem::path(source).extension().string();
+  if (extension == ".pbrt" || (extension != ".json" && looks_like_pbrt(json_text)))
+    return parse_pbrt_scene(json_text, read_obj, source, limits);
   return SceneParser(read_obj, source, limits).parse(json_text);
 }
 

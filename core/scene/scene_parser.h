@@ -18,12 +18,15 @@ using ObjFileReader = std::function<std::string(const std::string& relative_path
 
 struct ParsedScene {
   Scene scene;
-  // Each OBJ file the scene names, in order of first appearance: (relative path, bytes).
+  // Each file the scene names (OBJ; pbrt-v3: Include, PLY, image textures), in order of first
+  // appearance: (relative path, bytes).
   std::vector<std::pair<std::string, std::string>> obj_files;
 };
 
-// Parses and validates a scene, fills every derived field and the content hash. Throws
-// FormatError naming `source`, the JSON path and the bad value.
+// Parses and validates a scene, fills every derived field and the content hash. A pbrt-v3 file
+// (by the extension of `source`, or by its content: pbrt_scene_builder.h) goes to the pbrt-v3
+// reader, whose files (Include, PLY, textures) come through the same reader callback. Throws
+// FormatError naming `source` and the JSON path or file:line:column.
 ParsedScene parse_scene_with_reader(const std::string& json_text, const ObjFileReader& read_obj,
                                     const std::string& source, const SceneLimits& limits);
 

@@ -20,7 +20,7 @@ std::string normalize_scene_relative_path(const std::string& path) {
   fs::path given(path);
   if (given.is_absolute() || given.has_root_directory() || given.has_root_name())
     throw std::invalid_argument("absolute path '" + path +
-                                "' (OBJ paths are relative to the scene file)");
+                                "' (the files a scene names are relative to the scene file)");
   fs::path normal = given.lexically_normal();
   if (normal.empty() || normal == "." || *normal.begin() == "..")
     throw std::invalid_argument("path '" + path + "' leaves the scene's folder");
@@ -44,7 +44,16 @@ std::string read_whole_file(const std::string& path, size_t max_bytes, const cha
                                 std::to_string(max_bytes));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument("cannot open '" + path + "'");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Read in blocks (a file may change size between the size query and the read).
+  std::string bytes;
+  bytes.resize(static_cast<size_t>(std::min<uintmax_t>(size, max_bytes)) + 1);
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<size_t>(in.gcount()));
+  while (in && bytes.size() <= max_bytes) {
+    char block[65536];
+    in.read(block, sizeof block);
+    bytes.append(block, static_cast<size_t>(in.gcount()));
+  }
   if (in.bad()) throw std::invalid_argument("error while reading '" + path + "'");
   if (bytes.size() > max_bytes)
     throw std::invalid_argument("'" + path + "' grew past the limit " + std::string(limit_name) +

@@ -2,14 +2,87 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
 namespace penumbra {
+
+size_t append_mesh_to_scene(Scene& scene, const TriangleMesh& mesh, uint32_t material,
+                            const SceneLimits& limits) {
+  size_t have = scene.triangle_count(), more = mesh.triangle_count();
+  if (more > limits.max_triangles || have > limits.max_triangles - more)
+    throw std::invalid_argument(
+        "too many triangles: this shape adds " + std::to_string(more) + " to " +
+        std::to_string(have) +
+        ", past the limit max_triangles = " + std::to_string(limits.max_triangles));
+  for (const Vec3& p : mesh.positions)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!(std::abs(p[axis]) <= limits.max_coordinate)) {
+        std::ostringstream out;
+        out.precision(12);
+        out << "a vertex coordinate " << p[axis]
+            << " exceeds the limit max_coordinate = " << limits.max_coordinate;
+        throw std::invalid_argument(out.str());
+      }
+  if (scene.positions.size() + mesh.positions.size() > std::numeric_limits<uint32_t>::max())
+    throw std::invalid_argument("too many vertices for 32-bit indices");
+  const auto base = static_cast<uint32_t>(scene.positions.size());
+  // Shading normals and uvs stay parallel to the positions once any mesh has them.
+  const bool keep_normals = !mesh.normals.empty() || !scene.normals.empty();
+  const bool keep_uvs = !mesh.uvs.empty() || !scene.uvs.empty();
+  if (keep_normals) scene.normals.resize(base);
+  if (keep_uvs) scene.uvs.resize(base);
+  scene.positions.insert(scene.positions.end(), mesh.positions.begin(), mesh.positions.end());
+  if (keep_normals) {
+    if (mesh.normals.empty())
+      scene.normals.resize(scene.positions.size());
+    else
+      scene.normals.insert(scene.normals.end(), mesh.normals.begin(), mesh.normals.end());
+  }
+  if (keep_uvs) {
+    if (mesh.uvs.empty())
+      scene.uvs.resize(scene.positions.size());
+    else
+      scene.uvs.insert(scene.uvs.end(), mesh.uvs.begin(), mesh.uvs.end());
+  }
+  // Grow geometrically: scenes of many meshes append hundreds of times.
+  auto make_room = [](auto& array, size_t extra) {
+    if (array.capacity() < array.size() + extra)
+      array.reserve(std::max(array.size() + extra, 2 * array.capacity()));
+  };
+  make_room(scene.indices, mesh.indices.size());
+  make_room(scene.triangle_materials, more);
+  // Which per-vertex data each triangle has (Scene::triangle_shading), once any mesh has some.
+  const uint8_t shading =
+      (mesh.normals.empty() ? 0 : kTriangleHasNormals) | (mesh.uvs.empty() ? 0 : kTriangleHasUvs);
+  const bool keep_shading = shading != 0 || !scene.triangle_shading.empty();
+  if (keep_shading) {
+    scene.triangle_shading.resize(scene.triangle_count());
+    make_room(scene.triangle_shading, more);
+  }
+  size_t dropped = 0;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const Vec3& a = mesh.positions[mesh.indices[t]];
+    const Vec3& b = mesh.positions[mesh.indices[t + 1]];
+    const Vec3& c = mesh.positions[mesh.indices[t + 2]];
+    if (length_squared(cross(b - a, c - a)) == 0) {
+      ++dropped;
+      continue;
+    }
+    scene.indices.push_back(base + mesh.indices[t]);
+    scene.indices.push_back(base + mesh.indices[t + 1]);
+    scene.indices.push_back(base + mesh.indices[t + 2]);
+    scene.triangle_materials.push_back(material);
+    if (keep_shading) scene.triangle_shading.push_back(shading);
+  }
+  return dropped;
+}
 
 TriangleMesh quad_mesh(const Vec3& origin, const Vec3& edge1, const Vec3& edge2) {
   TriangleMesh mesh;

@@ -8,14 +8,27 @@
 #include <vector>
 
 #include "core/math/vec.h"
+#include "core/scene/scene.h"
 
 namespace penumbra {
 
 struct TriangleMesh {
   std::vector<Vec3> positions;
   std::vector<uint32_t> indices;  // 3 per triangle
+  // Optional per-vertex shading normals and texture coordinates: empty, or one per position.
+  std::vector<Vec3> normals;
+  std::vector<Vec2> uvs;
   size_t triangle_count() const { return indices.size() / 3; }
 };
+
+// Appends `mesh` to the scene's flat arrays with one material for all its triangles, dropping
+// triangles of exactly zero area (they occlude nothing and would only burden the ray and line
+// queries); keeps Scene::normals and Scene::uvs parallel to the positions when the mesh or the
+// scene has them, and Scene::triangle_shading saying which each triangle has. Returns the number of
+// triangles dropped. Throws std::invalid_argument when a limit would be passed (triangles,
+// coordinates, 32-bit vertex indices).
+size_t append_mesh_to_scene(Scene& scene, const TriangleMesh& mesh, uint32_t material,
+                            const SceneLimits& limits);
 
 // The parallelogram origin + s*edge1 + t*edge2 as 2 triangles wound like cross(edge1, edge2).
 TriangleMesh quad_mesh(const Vec3& origin, const Vec3& edge1, const Vec3& edge2);

@@ -7,8 +7,10 @@
 // light sends it nothing) gets no sample, and the density is 0 there.
 
 #include <optional>
+#include <string>
 #include <string_view>
 
+#include "core/strategies/registry.h"
 #include "core/strategies/strategy.h"
 
 namespace penumbra {
@@ -17,6 +19,10 @@ class AreaStrategy {
  public:
   // The strategy's name in the method grammar (SCENE_FORMAT.md).
   static constexpr std::string_view name() { return "area"; }
+  static constexpr StrategyFamily kFamily = StrategyFamily::Point;
+  static constexpr bool kRectangleStrata = true;
+  // Runs on every light and material.
+  static std::optional<std::string> refusal(const Scene&, LineDirection) { return std::nullopt; }
 
   AreaStrategy(const ShadingPoint& sp, const Light& light);
   std::optional<LightPoint> sample(const Vec2& u) const;

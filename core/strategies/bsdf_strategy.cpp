@@ -14,7 +14,7 @@ BsdfStrategy::BsdfStrategy(const ShadingPoint& sp, const Light& light)
 
 std::optional<LightPoint> BsdfStrategy::sample(const Vec2& u) const {
   if (!active_) return std::nullopt;
-  auto bsdf_sample = sample_bsdf(*sp_.material, sp_.normal, sp_.wo, u);
+  auto bsdf_sample = sample_shading_bsdf(sp_, u);
   if (!bsdf_sample) return std::nullopt;
   auto hit = intersect_light(*light_, sp_.position, bsdf_sample->wi, 0.0,
                              std::numeric_limits<double>::infinity());
@@ -32,7 +32,7 @@ double BsdfStrategy::pdf(const Vec3& light_point) const {
   if (!(r_squared > 0)) return 0;
   double r = std::sqrt(r_squared);
   Vec3 wi = d / r;
-  double pdf_sa = pdf_bsdf(*sp_.material, sp_.normal, sp_.wo, wi);
+  double pdf_sa = shading_bsdf_pdf(sp_, wi);
   double pdf_area = pdf_sa * std::abs(dot(light_->normal, wi)) / r_squared;
   return std::isfinite(pdf_area) ? pdf_area : 0.0;
 }

@@ -8,8 +8,10 @@
 // strategies agree on where the integrand is zero.
 
 #include <optional>
+#include <string>
 #include <string_view>
 
+#include "core/strategies/registry.h"
 #include "core/strategies/strategy.h"
 
 namespace penumbra {
@@ -18,6 +20,10 @@ class BsdfStrategy {
  public:
   // The strategy's name in the method grammar (SCENE_FORMAT.md).
   static constexpr std::string_view name() { return "bsdf"; }
+  static constexpr StrategyFamily kFamily = StrategyFamily::Point;
+  static constexpr bool kRectangleStrata = false;
+  // Runs on every light and material.
+  static std::optional<std::string> refusal(const Scene&, LineDirection) { return std::nullopt; }
 
   BsdfStrategy(const ShadingPoint& sp, const Light& light);
   std::optional<LightPoint> sample(const Vec2& u) const;

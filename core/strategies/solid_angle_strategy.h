@@ -5,8 +5,8 @@
 // - Rectangular quads (edges perpendicular to 1e-6 relative): Ureña, Fajardo & King 2013
 //   (core/math/spherical_rectangle.h); u.x picks the line along edge2, u.y the point on it.
 // - Other parallelograms and polygons: Peters 2021 Sec. 5 (SolidAnglePolygonSampler,
-//   core/polygon/solid_angle_polygon.h, which is also PetersSolidAngleStrategy's): the triangle
-//   fan around vertex 0, a triangle chosen by its solid angle (van Oosterom & Strackee), then
+//   core/polygon/solid_angle_polygon.h): the triangle fan around vertex 0, a triangle chosen
+//   by its solid angle (van Oosterom & Strackee), then
 //   Peters' subtriangle construction of Arvo 1995's map; every fan triangle is prepared once per
 //   shading point (no heap allocation). Polygons of more than kMaxPolygonVertices (16) vertices
 //   (the scene format allows 1024) use the same construction with each triangle's solid angle
@@ -22,10 +22,12 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "core/math/spherical_rectangle.h"
 #include "core/polygon/solid_angle_polygon.h"
+#include "core/strategies/registry.h"
 #include "core/strategies/strategy.h"
 
 namespace penumbra {
@@ -34,6 +36,10 @@ class SolidAngleStrategy {
  public:
   // The strategy's name in the method grammar (SCENE_FORMAT.md).
   static constexpr std::string_view name() { return "sa"; }
+  static constexpr StrategyFamily kFamily = StrategyFamily::Point;
+  static constexpr bool kRectangleStrata = true;
+  // Runs on every light and material.
+  static std::optional<std::string> refusal(const Scene&, LineDirection) { return std::nullopt; }
 
   SolidAngleStrategy(const ShadingPoint& sp, const Light& light);
   std::optional<LightPoint> sample(const Vec2& u) const;

@@ -17,7 +17,7 @@ COPY tools tools
 COPY scenes scenes
 RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DPENUMBRA_FARM=ON \
       -DPENUMBRA_TESTS=OFF -DPENUMBRA_BENCH=OFF \
-    && ninja -C build penumbra-coordinator penumbra
+    && ninja -C build penumbra-coordinator penumbra penumbra_oiio
 
 FROM debian:12.8
 # Only the shared libraries the binaries load (their DT_NEEDED packages), curl for the health
@@ -26,7 +26,7 @@ RUN apt-get update \
     && apt-get install -y --no-install-recommends \
        libabsl20220623 libembree3-3 libfmt9 libgrpc++1.51 libgrpc29 libopenimageio2.4 \
        libprotobuf32 libspdlog1.10 libsqlite3-0 libssl3 libtbb12 libtinyobjloader2rc10 \
-       libcpp-httplib0.11 libplplotcxx15 curl ca-certificates \
+       libcpp-httplib0.11 libplplotcxx15 libpolyclipping22 zlib1g curl ca-certificates \
     && rm -rf /var/lib/apt/lists/*
 RUN groupadd --system --gid 10001 penumbra \
     && useradd --system --uid 10001 --gid penumbra --home-dir /var/lib/penumbra \
@@ -34,6 +34,7 @@ RUN groupadd --system --gid 10001 penumbra \
     && install -d -o penumbra -g penumbra -m 0750 /var/lib/penumbra
 COPY --from=build /src/build/server/penumbra-coordinator /usr/local/bin/penumbra-coordinator
 COPY --from=build /src/build/client/penumbra /usr/local/bin/penumbra
+COPY --from=build /src/build/lib/libpenumbra_oiio.so /usr/local/lib/penumbra/libpenumbra_oiio.so
 USER penumbra
 WORKDIR /var/lib/penumbra
 VOLUME ["/var/lib/penumbra"]

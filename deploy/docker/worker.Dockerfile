@@ -17,7 +17,7 @@ COPY tools tools
 COPY scenes scenes
 RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DPENUMBRA_FARM=ON \
       -DPENUMBRA_TESTS=OFF -DPENUMBRA_BENCH=OFF \
-    && ninja -C build penumbra-worker
+    && ninja -C build penumbra-worker penumbra_oiio
 
 FROM debian:12.8
 RUN apt-get update \
@@ -30,6 +30,7 @@ RUN groupadd --system --gid 10001 penumbra \
        --shell /usr/sbin/nologin penumbra \
     && install -d -o penumbra -g penumbra -m 0750 /var/cache/penumbra
 COPY --from=build /src/build/worker/penumbra-worker /usr/local/bin/penumbra-worker
+COPY --from=build /src/build/lib/libpenumbra_oiio.so /usr/local/lib/penumbra/libpenumbra_oiio.so
 USER penumbra
 WORKDIR /var/cache/penumbra
 ENV PENUMBRA_COORDINATOR=coordinator:7420

@@ -61,12 +61,14 @@ bool is_terminal(v1::BatchState state) {
 }
 
 BatchClient::BatchClient(const std::string& address)
-    : channel_(make_farm_channel(address)),
+    : address_(address),
+      channel_(make_farm_channel(address)),
       stub_(v1::Batches::NewStub(channel_)),
       jobs_(v1::Jobs::NewStub(channel_)) {}
 
 BatchClient::BatchClient(const FarmConnection& connection)
-    : channel_(make_farm_channel(connection)),
+    : address_(connection.address),
+      channel_(make_farm_channel(connection)),
       stub_(v1::Batches::NewStub(channel_)),
       jobs_(v1::Jobs::NewStub(channel_)) {}
 
@@ -75,6 +77,16 @@ v1::SubmitBatchResponse BatchClient::submit(const v1::SubmitBatchRequest& reques
   v1::SubmitBatchResponse response;
   check(stub_->SubmitBatch(&context, request, &response));
   return response;
+}
+
+v1::SubmitBatchResponse BatchClient::upload_and_submit(v1::SubmitBatchRequest request,
+                                                       const std::string& scene_hash) {
+  if (request.has_scene()) {
+    upload_scene(*jobs_, address_, request.scene(), scene_hash);
+    request.clear_scene();
+  }
+  request.set_scene_hash(scene_hash);
+  return submit(request);
 }
 
 v1::BatchStatus BatchClient::status(const std::string& batch_id) {
@@ -161,7 +173,8 @@ v1::SubmitBatchRequest make_batch_request_from_text(
     return std::filesystem::exists(beside) ? beside : p;
   };
   bool is_path = spec.scene.find('/') != std::string::npos ||
-                 (spec.scene.size() > 5 && spec.scene.ends_with(".json"));
+                 (spec.scene.size() > 5 && spec.scene.ends_with(".json")) ||
+                 (spec.scene.size() > 5 && spec.scene.ends_with(".pbrt"));
   std::string scene_path = is_path ? resolve(spec.scene).string() : bundled_scene_path(spec.scene);
   try {
     *request.mutable_scene() = pack_scene_file(scene_path);

@@ -26,6 +26,11 @@ class BatchClient {
   explicit BatchClient(const FarmConnection& connection);
 
   v1::SubmitBatchResponse submit(const v1::SubmitBatchRequest& request);
+  // The request's scene package uploaded in chunks first (upload_scene, farm_client.h; its
+  // content hash is `scene_hash`), then the request submitted naming it by hash: no message
+  // carries the whole scene.
+  v1::SubmitBatchResponse upload_and_submit(v1::SubmitBatchRequest request,
+                                            const std::string& scene_hash);
   v1::BatchStatus status(const std::string& batch_id);  // with the runs' curves
   std::vector<v1::BatchStatus> list();
   v1::BatchStatus cancel(const std::string& batch_id);
@@ -38,6 +43,7 @@ class BatchClient {
                         std::chrono::milliseconds timeout = std::chrono::hours(24 * 365));
 
  private:
+  std::string address_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::Batches::Stub> stub_;
   std::unique_ptr<v1::Jobs::Stub> jobs_;

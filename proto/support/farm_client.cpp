@@ -11,6 +11,8 @@
 #include <sstream>
 #include <thread>
 
+#include "proto/support/scene_chunks.h"
+
 namespace penumbra::farm {
 
 namespace {
@@ -229,6 +231,63 @@ std::unique_ptr<grpc::ClientContext> call_context(
 }
 
 }  // namespace
+
+SceneUploadResult upload_scene(v1::Jobs::Stub& stub, const std::string& address,
+                               const v1::ScenePackage& package, const std::string& scene_hash,
+                               const SceneUploadOptions& options) {
+  const std::string bytes = serialize_package(package);
+  const v1::SceneManifest manifest = make_scene_manifest(scene_hash, bytes, options.chunk_bytes);
+  SceneUploadResult result;
+  result.scene_hash = scene_hash;
+  result.chunks_total = uint32_t(manifest.chunk_hashes_size());
+  v1::SceneUploadState state;
+  {
+    auto context = call_context();
+    check(stub.StartSceneUpload(context.get(), manifest, &state), address);
+  }
+  if (state.complete()) {
+    result.complete = result.already_stored = true;
+    return result;
+  }
+  // A chunk the coordinator had at the start may be gone at the end (the upload of another
+  // scene that shares it finished and dropped it): then another round sends what is missing.
+  for (int round = 0; round < 3 && !state.complete(); ++round) {
+    auto context = call_context(std::chrono::seconds(3600));
+    v1::SceneUploadState done;
+    std::unique_ptr<grpc::ClientWriter<v1::SceneUploadMessage>> writer =
+        stub.UploadScene(context.get(), &done);
+    v1::SceneUploadMessage message;
+    *message.mutable_manifest() = manifest;
+    bool open = writer->Write(message);
+    for (uint32_t index : state.missing_chunks()) {
+      if (!open) break;
+      if (options.stop_after_chunks && result.chunks_sent >= options.stop_after_chunks) break;
+      v1::SceneChunk& chunk = *message.mutable_chunk();
+      chunk.set_index(index);
+      const size_t begin = size_t(index) * manifest.chunk_bytes();
+      chunk.set_data(bytes.substr(begin, scene_chunk_size(manifest, index)));
+      open = writer->Write(message);
+      if (open) ++result.chunks_sent;
+    }
+    writer->WritesDone();
+    check(writer->Finish(), address);
+    state = done;
+    if (options.stop_after_chunks) break;
+  }
+  result.complete = state.complete();
+  if (!result.complete && !options.stop_after_chunks)
+    throw FarmCallError(grpc::StatusCode::ABORTED,
+                        "scene " + scene_hash.substr(0, 12) + ": " +
+                            std::to_string(state.missing_chunks_size()) +
+                            " chunk(s) still missing after three upload rounds");
+  return result;
+}
+
+SceneUploadResult FarmClient::upload_scene(const v1::ScenePackage& package,
+                                           const std::string& scene_hash,
+                                           const SceneUploadOptions& options) {
+  return farm::upload_scene(*stub_, address_, package, scene_hash, options);
+}
 
 v1::SubmitJobResponse FarmClient::submit(const v1::JobSpec& spec) {
   v1::SubmitJobRequest request;

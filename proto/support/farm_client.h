@@ -61,12 +61,39 @@ bool is_loopback_address(const std::string& address);
 // the file cannot be read or is empty), else the environment variable PENUMBRA_TOKEN, else "".
 std::string resolve_token(const std::string& token, const std::string& token_file);
 
+// A scene upload's outcome (upload_scene).
+struct SceneUploadResult {
+  std::string scene_hash;
+  bool complete = false;        // the coordinator stores the scene
+  bool already_stored = false;  // it did before this call: nothing was sent
+  uint32_t chunks_total = 0;
+  uint32_t chunks_sent = 0;  // by this call (chunks the coordinator had are skipped)
+};
+
+struct SceneUploadOptions {
+  uint32_t chunk_bytes = uint32_t(1) << 20;  // kSceneChunkBytes (proto/support/scene_chunks.h)
+  // Ends the stream after sending this many chunks (0: send them all), leaving the upload
+  // incomplete: how tests stand in for an upload cut short.
+  uint32_t stop_after_chunks = 0;
+};
+
+// Uploads a package in chunks (Jobs.StartSceneUpload, then Jobs.UploadScene with the chunks the
+// coordinator lacks), so jobs and batches can name it by `scene_hash` (its content hash, as
+// core computes it: the coordinator checks it). Throws FarmCallError (RESOURCE_EXHAUSTED over
+// the coordinator's scene-size limit, INVALID_ARGUMENT for a scene it cannot parse).
+SceneUploadResult upload_scene(v1::Jobs::Stub& stub, const std::string& address,
+                               const v1::ScenePackage& package, const std::string& scene_hash,
+                               const SceneUploadOptions& options = {});
+
 class FarmClient {
  public:
   explicit FarmClient(const std::string& address);
   explicit FarmClient(const FarmConnection& connection);
 
   v1::SubmitJobResponse submit(const v1::JobSpec& spec);
+  // upload_scene on this client's channel.
+  SceneUploadResult upload_scene(const v1::ScenePackage& package, const std::string& scene_hash,
+                                 const SceneUploadOptions& options = {});
   v1::JobStatus status(const std::string& job_id);
   std::vector<v1::JobStatus> list();
   v1::JobState cancel(const std::string& job_id);

@@ -38,7 +38,7 @@ TEST(BatchCalibrationRestart, KillsWhileCalibratingAndWhileRenderingOnLoseNothin
     "format": "penumbra/batch@1", "name": "restarts", "scene": "batch-test.json",
     "methods": ["sa", "area"], "budget": {"seconds": )" +
                            std::to_string(budget) + R"(},
-    "reference": {"method": "sa", "spp": 16}, "seed": 7})";
+    "reference": {"method": "sa", "spp": 16}, "seed": 7, "repeats": 1})";
   std::string batch_id =
       BatchClient(coordinator.address()).submit(testing::batch_request(dir, spec)).batch_id();
   auto status_now = [&]() -> std::optional<v1::BatchStatus> {

@@ -48,7 +48,7 @@ TEST(BatchFarm, EqualTimeByCalibrationAndTheResultFolder) {
                      R"(, "spp": [4]},
     "reference": {"method": "bsdf+sa", "spp": 64},
     "regions": {"corner": [0, 0, 16, 16]},
-    "seed": 3})";
+    "seed": 3, "repeats": 1})";
   BatchClient client(coordinator.address());
   v1::SubmitBatchResponse response = client.submit(testing::batch_request(dir, spec));
   v1::BatchStatus status = testing::run_to_end(client, response.batch_id());

@@ -19,7 +19,7 @@ std::string spec_with(const std::string& name, int reference_spp, int spp) {
          R"(", "scene": "batch-test.json", "methods": ["sa", "area"],
     "budget": {"spp": [)" +
          std::to_string(spp) + R"(]}, "reference": {"method": "bsdf+sa", "spp": )" +
-         std::to_string(reference_spp) + "}}";
+         std::to_string(reference_spp) + R"(}, "repeats": 1})";
 }
 
 TEST(BatchReference, RenderedOncePerSceneAndSpecThenReusedAcrossRestarts) {

@@ -22,6 +22,7 @@ const char* kFull = R"({
   "regions": {"penumbra": [1, 2, 30, 40]},
   "seed": 7,
   "repeats": 3,
+  "strict": true,
   "future": true
 })";
 
@@ -47,6 +48,7 @@ TEST(BatchSpec, ReadsEveryField) {
   EXPECT_EQ(spec.regions.at("penumbra").x1, 30);
   EXPECT_EQ(spec.seed, 7u);
   EXPECT_EQ(spec.repeats, 3u);
+  EXPECT_TRUE(spec.strict);
   ASSERT_EQ(spec.warnings.size(), 1u);
   EXPECT_NE(spec.warnings[0].find("$.future"), std::string::npos);
 }
@@ -56,11 +58,12 @@ TEST(BatchSpec, DefaultsAndReferenceForms) {
     "methods": ["sa"], "budget": {"spp": [4]}})";
   BatchSpec spec = parse_batch_spec(minimal, "dir/my-batch.json");
   EXPECT_EQ(spec.name, "my-batch");
+  EXPECT_FALSE(spec.strict) << "scene warnings are printed and carried by default";
   EXPECT_FALSE(spec.budget_seconds.has_value());
   EXPECT_EQ(spec.reference.kind, BatchReferenceKind::Auto);
   EXPECT_EQ(spec.reference.method, "bsdf+sa");
   EXPECT_EQ(spec.seed, 1u);
-  EXPECT_EQ(spec.repeats, 1u);
+  EXPECT_EQ(spec.repeats, 3u);  // intervals need repeats: three by default
 
   auto with_reference = [](const std::string& reference) {
     return R"({"format": "penumbra/batch@1", "scene": "s", "methods": ["sa"],
@@ -109,6 +112,7 @@ TEST(BatchSpec, EveryErrorNamesItsField) {
       {spec_with("format", R"("penumbra/batch@2")"), "$.format", "version"},
       {spec_with("format", R"("penumbra/scene@1")"), "$.format", "not a batch"},
       {spec_with("scene", ""), "$.scene", "missing"},
+      {spec_with("strict", "1"), "$.strict", "true or false"},
       {spec_with("scene", "3"), "$.scene", "string"},
       {spec_with("scene", R"("")"), "$.scene", "empty"},
       {spec_with("methods", ""), "$.methods", "missing"},
@@ -188,9 +192,13 @@ TEST(BatchSpec, FileSafeLabels) {
   EXPECT_EQ(file_safe_label("../x"), ".._x");
 }
 
-// Every bundled batch reads without warnings and names a bundled scene.
+// Every bundled batch reads without warnings and names a scene that exists: a bundled scene by
+// name, or a file by a path relative to the batch's folder (as the client resolves it). Paths into
+// ../shared/peer-scenes are only checked where that folder is present.
 TEST(BatchSpec, BundledBatchesRead) {
-  std::filesystem::path dir = std::filesystem::path(PENUMBRA_SOURCE_DIR) / "batches";
+  const std::filesystem::path source = PENUMBRA_SOURCE_DIR;
+  const std::filesystem::path dir = source / "batches";
+  const bool peer_scenes = std::filesystem::exists(source / ".." / "shared" / "peer-scenes");
   int count = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".json") continue;
@@ -199,12 +207,53 @@ TEST(BatchSpec, BundledBatchesRead) {
     text << in.rdbuf();
     BatchSpec spec = parse_batch_spec(text.str(), entry.path().string());
     EXPECT_TRUE(spec.warnings.empty()) << entry.path() << ": " << spec.warnings.front();
-    std::filesystem::path scene =
-        std::filesystem::path(PENUMBRA_SOURCE_DIR) / "scenes" / (spec.scene + ".json");
-    EXPECT_TRUE(std::filesystem::exists(scene)) << entry.path() << " names " << spec.scene;
+    const bool is_path = spec.scene.find('/') != std::string::npos ||
+                         spec.scene.ends_with(".json") || spec.scene.ends_with(".pbrt");
+    const std::filesystem::path scene =
+        is_path ? dir / spec.scene : source / "scenes" / (spec.scene + ".json");
+    const bool in_peer_scenes = spec.scene.find("shared/peer-scenes/") != std::string::npos;
+    if (!in_peer_scenes || peer_scenes) {
+      EXPECT_TRUE(std::filesystem::exists(scene)) << entry.path() << " names " << spec.scene;
+    }
     ++count;
   }
   EXPECT_GE(count, 1);
+}
+
+}  // namespace
+}  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+TEST(BatchSpec, ExactReferenceAndBaseline) {
+  BatchSpec spec = parse_batch_spec(
+      R"({"format": "penumbra/batch@1", "scene": "s", "methods": ["sa", "area"],
+          "budget": {"seconds": 1}, "baseline": "area",
+          "reference": {"kind": "exact", "camera_samples": 9, "fallback": "bsdf",
+                        "fallback_samples": 32}})",
+      "b");
+  EXPECT_EQ(spec.reference.kind, BatchReferenceKind::Exact);
+  EXPECT_EQ(spec.reference.camera_samples, 9u);
+  EXPECT_EQ(spec.reference.fallback_method, "bsdf");
+  EXPECT_EQ(spec.reference.fallback_samples, 32u);
+  EXPECT_EQ(spec.baseline, "area");
+  auto fails_at = [](const std::string& text, const std::string& path) {
+    try {
+      parse_batch_spec(text, "b");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const FormatError& error) {
+      EXPECT_EQ(error.json_path(), path) << error.what();
+    }
+  };
+  const std::string head =
+      R"({"format": "penumbra/batch@1", "scene": "s", "methods": ["sa"], "budget": {"spp": [2]}, )";
+  fails_at(head + R"("baseline": "nope"})", "$.baseline");
+  fails_at(head + R"("reference": {"kind": "magic"}})", "$.reference.kind");
+  fails_at(head + R"("reference": {"kind": "exact", "camera_samples": 0}})",
+           "$.reference.camera_samples");
+  fails_at(head + R"("reference": {"kind": "exact", "fallback": "no-such"}})",
+           "$.reference.fallback");
 }
 
 }  // namespace

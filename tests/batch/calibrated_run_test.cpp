@@ -267,9 +267,10 @@ TEST_F(CalibratedRunTest, JobsABatchNeverRecordedAreCancelledWhenItIsLoaded) {
   auto manager = std::make_unique<BatchManager>(*coordinator, parse_wire_package, batch_options);
   const std::string spec_json = R"({"format": "penumbra/batch@1", "name": "orphans", "scene": ")" +
                                 scene_path_ + R"(", "methods": ["sa", "area"],
-    "budget": {"seconds": 10}, "reference": {"method": "sa", "spp": 2}})";
+    "budget": {"seconds": 10}, "reference": {"method": "sa", "spp": 2}, "repeats": 1})";
   const std::string batch_id =
-      manager->submit(testing::batch_request(dir_, spec_json), "tester").batch_id();
+      manager->submit(testing::batch_request(dir_, spec_json), CallContext::of_client("tester"))
+          .batch_id();
   // The reference renders; then the batch submits its equal-time runs and stores them.
   v1::BatchStatus status;
   for (int round = 0; round < 500; ++round) {

@@ -1,6 +1,8 @@
-// The dashboard in headless Chromium against a real coordinator and worker: the jobs are listed,
-// a running job's progress moves between two DOM dumps, its MRSE-against-time chart is drawn
-// (an SVG path through the curve's points), the workers are listed, and a screenshot is saved.
+// The dashboard in headless Chromium against a real coordinator with tokens and a worker, opened
+// as a browser user would (a viewer token in the address: the script sends it to the JSON API as
+// a header): the jobs are listed, a running job's progress moves between two DOM dumps, its
+// MRSE-against-time chart is drawn (an SVG path through the curve's points), the workers are
+// listed, and a screenshot is saved.
 #include <gtest/gtest.h>
 
 #include <regex>
@@ -48,8 +50,18 @@ int count(const std::string& dom, const std::string& needle) {
 TEST(Dashboard, ChromiumShowsJobsProgressChartAndWorkers) {
   if (!std::filesystem::exists(kChromium)) GTEST_SKIP() << "no " << kChromium;
   auto dir = fresh_directory("dashboard");
-  HttpCoordinator coordinator(dir / "coordinator");
-  FarmClient client(coordinator.process.address());
+  const std::string client_token = "client-dash-0123456789abcdef";
+  const std::string worker_token = "worker-dash-0123456789abcdef";
+  const std::string viewer_token = "viewer-dash-0123456789abcdef";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "tokens.txt") << "client dash " << client_token << "\nworker w "
+                                    << worker_token << "\nviewer wall " << viewer_token << "\n";
+  HttpCoordinator coordinator(dir / "coordinator", 2.0,
+                              {"--tokens-file", (dir / "tokens.txt").string()});
+  FarmConnection connection;
+  connection.address = coordinator.process.address();
+  connection.token = client_token;
+  FarmClient client(connection);
   std::string scene = write_scene(dir, 96, 64);
 
   // A reference, then a long job scored against it (one pass per task: the curve grows fast).
@@ -59,11 +71,15 @@ TEST(Dashboard, ChromiumShowsJobsProgressChartAndWorkers) {
   spec.set_reference_job(reference);
   spec.set_name("dashboard-job");
   std::string job = client.submit(spec).job_id();
-  auto worker = start_worker(coordinator.process.address(), dir, "dash-worker", 1);
+  auto worker = start_worker_with(coordinator.process.address(), dir, "dash-worker",
+                                  {"--token", worker_token});
   wait_until(client, job, [](const v1::JobStatus& s) { return s.curve_size() >= 2; });
 
-  std::string first = dump_dom(coordinator.url(), dir / "profile");
-  std::string second = dump_dom(coordinator.url(), dir / "profile");
+  // Without a token the page is refused.
+  EXPECT_EQ(coordinator.get("/").status, 401);
+  const std::string url = coordinator.url("/?token=" + viewer_token);
+  std::string first = dump_dom(url, dir / "profile");
+  std::string second = dump_dom(url, dir / "profile");
 
   // Jobs listed (both), the running one with its state.
   EXPECT_EQ(count(second, "class=\"job"), 2) << second.substr(0, 4000);
@@ -99,7 +115,7 @@ TEST(Dashboard, ChromiumShowsJobsProgressChartAndWorkers) {
               " --hide-scrollbars --user-data-dir=" +
               shell_quote((dir / "profile").string()) +
               " --window-size=1200,900 --virtual-time-budget=2000 --screenshot=" +
-              shell_quote(screenshot.string()) + " " + shell_quote(coordinator.url()));
+              shell_quote(screenshot.string()) + " " + shell_quote(url));
   // Best effort: on a heavily loaded machine Chromium's screenshot can outlast its 60 s timeout;
   // the checks above (two DOM dumps) are the test.
   if (std::filesystem::exists(screenshot))

@@ -138,13 +138,17 @@ inline Scrape parse_prometheus(const std::string& text, const std::filesystem::p
   return scrape;
 }
 
-// A coordinator process serving HTTP on loopback (a port that was free a moment ago).
+// A coordinator process serving HTTP on loopback (a port that was free a moment ago), with
+// further coordinator arguments (e.g. --tokens-file) in `extra`.
 struct HttpCoordinator {
-  explicit HttpCoordinator(const std::filesystem::path& data_dir, double lease_seconds = 2.0)
-      : http_port(free_port()),
-        process(data_dir, 0, {"--http-listen", "127.0.0.1:" + std::to_string(http_port)},
-                lease_seconds) {
+  explicit HttpCoordinator(const std::filesystem::path& data_dir, double lease_seconds = 2.0,
+                           std::vector<std::string> extra = {})
+      : http_port(free_port()), process(data_dir, 0, with_http(http_port, extra), lease_seconds) {
     wait_healthy("127.0.0.1", http_port);
+  }
+  static std::vector<std::string> with_http(int port, std::vector<std::string> extra) {
+    extra.insert(extra.begin(), {"--http-listen", "127.0.0.1:" + std::to_string(port)});
+    return extra;
   }
   HttpReply get(const std::string& path) const { return http_get("127.0.0.1", http_port, path); }
   std::string url(const std::string& path = "/") const {

@@ -138,6 +138,9 @@ TEST(HttpMetrics, ScrapedMetricsMoveWhenAJobRuns) {
   EXPECT_EQ(preview.content_type, "image/png");
   EXPECT_EQ(png_size(preview.body), std::make_pair(64u, 48u));
   EXPECT_EQ(preview.headers["X-Penumbra-Passes"], "16");
+  // The finished job's image itself (not black): the very bytes `penumbra render` would write as
+  // the preview of the job's EXR (one encoder).
+  EXPECT_EQ(preview.body, encode_png_preview(decode_exr(client.fetch(job))));
 
   // Errors: unknown job 404, bad exposure 400, unknown path 404; the dashboard page is HTML.
   EXPECT_EQ(coordinator.get("/api/jobs/job-999").status, 404);
@@ -147,6 +150,28 @@ TEST(HttpMetrics, ScrapedMetricsMoveWhenAJobRuns) {
   HttpReply page = coordinator.get("/");
   EXPECT_EQ(page.status, 200);
   EXPECT_NE(page.body.find("<svg id=\"chart\""), std::string::npos);
+  // Rendered on the server (no script has run): both jobs, the worker, the preview, the summary.
+  EXPECT_NE(
+      page.body.find("<tr class=\"job selected\" data-job-id=\"" + job + "\" data-state=\"done\""),
+      std::string::npos)
+      << page.body.substr(0, 6000);
+  EXPECT_NE(page.body.find("data-job-id=\"" + reference + "\""), std::string::npos);
+  EXPECT_NE(page.body.find("metrics &quot;test&quot;"), std::string::npos) << "escaped name";
+  EXPECT_NE(page.body.find("<tr class=\"worker\" data-worker-id=\"metrics-worker\" "
+                           "data-alive=\"true\">"),
+            std::string::npos);
+  EXPECT_NE(page.body.find("<img id=\"preview\" src=\"/api/jobs/" + job + "/preview.png"),
+            std::string::npos);
+  EXPECT_EQ(page.body.find("loading&hellip;"), std::string::npos);
+
+  // 64-bit integers are JSON numbers, exactly.
+  EXPECT_TRUE(jobs["jobs"][1]["submitted_unix_ms"].is_number_integer());
+  EXPECT_EQ(jobs["jobs"][1]["submitted_unix_ms"].get<int64_t>(),
+            client.status(job).submitted_unix_ms());
+  EXPECT_TRUE(detail["tasks_total"].is_number_integer());
+  EXPECT_EQ(detail["tasks_total"].get<uint64_t>(), client.status(job).tasks_total());
+  EXPECT_TRUE(detail["seed"].is_number_integer());
+  EXPECT_TRUE(workers["workers"][0]["tasks_completed"].is_number_integer());
 
   worker->signal(SIGTERM);
   worker->wait_exit(std::chrono::seconds(20));

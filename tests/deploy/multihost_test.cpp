@@ -173,7 +173,7 @@ TEST(MultiHost, CoordinatorAndThreeWorkersInNetworkNamespaces) {
     std::string spec_text = R"({"format": "penumbra/batch@1", "name": "multihost",
         "scene": ")" + scene +
                             R"(", "methods": ["sa", "bsdf+sa"], "budget": {"spp": [4, 8]},
-        "reference": {"method": "bsdf+sa", "spp": 32}, "seed": 3})";
+        "reference": {"method": "bsdf+sa", "spp": 32}, "seed": 3, "repeats": 1})";
     BatchClient batches(coordinator_address);
     auto request = make_batch_request_from_text(spec_text, "multihost-batch.json", dir.string(),
                                                 [](const std::string& name) { return name; });

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <thread>
 
 #include "fake_worker.h"
@@ -39,6 +41,9 @@ class CoordinatorTest : public ::testing::Test {
     scene_path_ = testing::write_scene(dir_, 40, 24);
     options_.data_dir = (dir_ / "data").string();
     options_.lease_time = 200ms;
+    // The fake workers do not heartbeat: here leases expire (after 200 ms) before a silent
+    // worker would be declared dead (4.5 heartbeats of 67 ms); the dead-worker test sets its own.
+    options_.missed_heartbeats = 4;
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
@@ -190,6 +195,200 @@ TEST_F(CoordinatorTest, RestartKeepsSealedBlocksAndCompletedTasks) {
   EXPECT_EQ(coordinator->status(job).state(), v1::JOB_STATE_DONE);
   EXPECT_TRUE(
       testing::same_bits(coordinator->result_film(job).color, expected_film(40, 24, 12).color));
+}
+
+// Cancelling keeps the sealed blocks as the job's result: an image of exactly the sealed passes
+// (bit for bit the image of a job of that spp), its spp in the metadata, fetchable and previewed,
+// with the task and tile counts of the moment of cancellation, across a restart too.
+TEST_F(CoordinatorTest, CancelKeepsTheSealedPassesAsAPartialResult) {
+  std::string job;
+  v1::JobStatus before;
+  {
+    auto coordinator = make();
+    std::string worker = register_worker(*coordinator, "w");
+    job = coordinator->submit(spec(12)).job_id();  // 3 blocks of 4 passes x 6 tiles
+    std::vector<v1::Task> tasks = lease(*coordinator, worker, 100);
+    ASSERT_EQ(tasks.size(), 18u);
+    for (size_t i = 0; i < 9; ++i) EXPECT_TRUE(complete(*coordinator, worker, tasks[i]));
+    before = coordinator->status(job);
+    ASSERT_EQ(before.passes_complete(), 4u);
+    ASSERT_EQ(before.tasks_complete(), 9u);
+    EXPECT_EQ(before.tasks_leased(), 9u);
+    EXPECT_EQ(coordinator->cancel(job), v1::JOB_STATE_CANCELLED);
+    for (const v1::JobStatus& after : {coordinator->status(job), coordinator->list().front()}) {
+      EXPECT_EQ(after.state(), v1::JOB_STATE_CANCELLED);
+      EXPECT_EQ(after.error(), "") << "the state says it; the error repeated it";
+      EXPECT_EQ(after.tasks_total(), before.tasks_total());
+      EXPECT_EQ(after.tasks_complete(), before.tasks_complete());
+      EXPECT_EQ(after.tiles_complete(), before.tiles_complete());
+      EXPECT_EQ(after.passes_complete(), 4u);
+      EXPECT_EQ(after.tasks_leased(), 0u);
+      EXPECT_TRUE(after.has_result());
+    }
+    ImageMetadata metadata;
+    Image variance;
+    Image color = decode_exr(coordinator->result_exr(job), &metadata, &variance);
+    Film expected = expected_film(40, 24, 4);
+    EXPECT_TRUE(testing::same_bits(color, expected.color));
+    EXPECT_TRUE(testing::same_bits(variance, expected.variance));
+    EXPECT_EQ(metadata["penumbra:spp"], "4");
+    EXPECT_EQ(metadata["penumbra:cancelled"], "after 4 of 12 planned passes");
+    uint32_t passes = 0;
+    EXPECT_TRUE(testing::same_bits(coordinator->preview_film(job, &passes).color, expected.color));
+    EXPECT_EQ(passes, 4u);
+    // A late result of the cancelled job is dropped.
+    EXPECT_FALSE(complete(*coordinator, worker, tasks[10]));
+  }
+  auto coordinator = make();
+  v1::JobStatus restarted = coordinator->status(job);
+  EXPECT_EQ(restarted.state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_EQ(restarted.tasks_complete(), before.tasks_complete());
+  EXPECT_EQ(restarted.tasks_total(), before.tasks_total());
+  EXPECT_TRUE(restarted.has_result());
+  EXPECT_TRUE(
+      testing::same_bits(coordinator->result_film(job).color, expected_film(40, 24, 4).color));
+
+  // Cancelled before any block was sealed: nothing to fetch, and the refusal says why.
+  std::string early = coordinator->submit(spec(8)).job_id();
+  coordinator->cancel(early);
+  EXPECT_FALSE(coordinator->status(early).has_result());
+  try {
+    coordinator->result_exr(early);
+    ADD_FAILURE() << "a result without sealed passes";
+  } catch (const FarmError& error) {
+    EXPECT_EQ(error.code(), FarmErrorCode::FailedPrecondition);
+    EXPECT_NE(std::string(error.what()).find("before any pass was sealed"), std::string::npos)
+        << error.what();
+  }
+}
+
+// A finished job's preview is its image (the per-tile sums are released when it ends; the
+// preview comes from the stored result), with the job's pass count.
+TEST_F(CoordinatorTest, AFinishedJobsPreviewIsItsImage) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "w");
+  std::string job = coordinator->submit(spec(8)).job_id();
+  for (const v1::Task& task : lease(*coordinator, worker, 100))
+    EXPECT_TRUE(complete(*coordinator, worker, task));
+  ASSERT_EQ(coordinator->status(job).state(), v1::JOB_STATE_DONE);
+  uint32_t passes = 0;
+  Film preview = coordinator->preview_film(job, &passes);
+  EXPECT_EQ(passes, 8u);
+  EXPECT_TRUE(testing::same_bits(preview.color, expected_film(40, 24, 8).color));
+  EXPECT_GT(*std::max_element(preview.color.rgb.begin(), preview.color.rgb.end()), 0.f);
+}
+
+// A worker that stops calling is dead after two missed heartbeats (and half an interval): its
+// tasks go to the others at once, long before its leases would expire, and its late results are
+// dropped (the lease is the fence). Its name is refused to another process while it is alive,
+// taken over once it is dead (a restart keeps its id), and it leaves the list after
+// forget_worker_after.
+TEST_F(CoordinatorTest, ADeadWorkersTasksAreReassignedAfterTwoMissedHeartbeats) {
+  options_.lease_time = 60s;  // expiry is not what reassigns here
+  options_.heartbeat_interval = 200ms;
+  options_.missed_heartbeats = 2;  // dead after 500 ms of silence
+  options_.forget_worker_after = 800ms;
+  auto coordinator = make();
+  const std::string dying = register_worker(*coordinator, "dying");
+  const std::string alive = register_worker(*coordinator, "alive");
+  EXPECT_EQ(dying, "dying") << "a worker's id is its name";
+  EXPECT_THROW(register_worker(*coordinator, "dying"), FarmError) << "a live worker's name";
+  std::string job = coordinator->submit(spec(4)).job_id();  // 6 tasks
+  std::vector<v1::Task> lost = lease(*coordinator, dying, 3);
+  ASSERT_EQ(lost.size(), 3u);
+  for (const v1::Task& task : lease(*coordinator, alive, 3))
+    EXPECT_TRUE(complete(*coordinator, alive, task));
+  EXPECT_EQ(coordinator->status(job).tasks_leased(), 3u);
+  // `alive` heartbeats every 50 ms; `dying` is silent. Its tasks come back within a second.
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<v1::Task> reassigned;
+  while (reassigned.size() < 3 && std::chrono::steady_clock::now() - start < 3s) {
+    std::this_thread::sleep_for(50ms);
+    v1::HeartbeatRequest heartbeat;
+    heartbeat.set_worker_id(alive);
+    coordinator->heartbeat(heartbeat);
+    for (const v1::Task& task : lease(*coordinator, alive, 3)) reassigned.push_back(task);
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(reassigned.size(), 3u);
+  EXPECT_GE(seconds, 0.45) << "reassigned before two heartbeats were missed";
+  EXPECT_LT(seconds, 2.0);
+  EXPECT_EQ(coordinator->counters().workers_lost, 1u);
+  for (const v1::WorkerInfo& worker : coordinator->workers())
+    EXPECT_EQ(worker.alive(), worker.worker_id() == alive) << worker.worker_id();
+  EXPECT_FALSE(complete(*coordinator, dying, lost[0])) << "the dead worker's result is late";
+  for (const v1::Task& task : reassigned) EXPECT_TRUE(complete(*coordinator, alive, task));
+  EXPECT_EQ(coordinator->status(job).state(), v1::JOB_STATE_DONE);
+  EXPECT_TRUE(
+      testing::same_bits(coordinator->result_film(job).color, expected_film(40, 24, 4).color));
+  // Dead, the name may be taken over (a restart keeps its id) ...
+  EXPECT_EQ(register_worker(*coordinator, "dying"), "dying");
+  // ... and a dead worker is forgotten after forget_worker_after.
+  const std::string gone = register_worker(*coordinator, "gone");
+  bool listed = true;
+  for (int i = 0; i < 100 && listed; ++i) {
+    std::this_thread::sleep_for(50ms);
+    listed = false;
+    for (const v1::WorkerInfo& worker : coordinator->workers())
+      listed |= worker.worker_id() == gone;
+  }
+  EXPECT_FALSE(listed) << "a dead worker stays listed";
+}
+
+// The scene reader's warnings travel in the job's status and EXR, or refuse the job under
+// spec.strict; a reference of another scene (by scene_hash) is refused unless
+// accept_reference_mismatch, which records a warning.
+TEST_F(CoordinatorTest, SceneWarningsAndReferenceMismatchesAreCarriedOrRefused) {
+  auto coordinator = make();
+  std::string worker = register_worker(*coordinator, "w");
+  std::string json = testing::small_scene_json(40, 24);
+  json.replace(json.find("\"fov_y_deg\": 40"), 15, "\"fov_y_deg\": 40, \"fovy\": 30");
+  std::ofstream(dir_ / "typo.json") << json;
+  v1::JobSpec typo = testing::job_spec((dir_ / "typo.json").string(), "sa", 4, 1, 16, 4);
+  v1::JobSpec strict = typo;
+  strict.set_strict(true);
+  try {
+    coordinator->submit(strict);
+    ADD_FAILURE() << "a scene with warnings passed spec.strict";
+  } catch (const FarmError& error) {
+    EXPECT_EQ(error.code(), FarmErrorCode::InvalidArgument);
+    EXPECT_NE(std::string(error.what()).find("$.camera.fovy"), std::string::npos) << error.what();
+  }
+  std::string job = coordinator->submit(typo).job_id();
+  v1::JobStatus status = coordinator->status(job);
+  ASSERT_EQ(status.warnings_size(), 1);
+  EXPECT_NE(status.warnings(0).find("$.camera.fovy"), std::string::npos);
+  for (const v1::Task& task : lease(*coordinator, worker, 100))
+    EXPECT_TRUE(complete(*coordinator, worker, task));
+  ImageMetadata metadata;
+  const std::string exr = coordinator->result_exr(job);
+  decode_exr(exr, &metadata);
+  EXPECT_NE(metadata["penumbra:warnings"].find("$.camera.fovy"), std::string::npos);
+
+  // `exr` is of the typo scene (another hash than spec(4)'s scene): refused as a reference,
+  // as is the job itself; accepted on request with a warning.
+  v1::JobSpec by_exr = spec(4);
+  by_exr.set_reference_exr(exr);
+  v1::JobSpec by_job = spec(4);
+  by_job.set_reference_job(job);
+  for (v1::JobSpec* refused : {&by_exr, &by_job}) {
+    try {
+      coordinator->submit(*refused);
+      ADD_FAILURE() << "a reference of another scene was accepted";
+    } catch (const FarmError& error) {
+      EXPECT_EQ(error.code(), FarmErrorCode::InvalidArgument);
+      EXPECT_NE(std::string(error.what()).find("another scene"), std::string::npos) << error.what();
+    }
+    refused->set_accept_reference_mismatch(true);
+    v1::JobStatus accepted = coordinator->status(coordinator->submit(*refused).job_id());
+    ASSERT_EQ(accepted.warnings_size(), 1);
+    EXPECT_NE(accepted.warnings(0).find("another scene"), std::string::npos);
+  }
+  // The same scene's result is a reference without a word.
+  v1::JobSpec same = typo;
+  same.set_reference_job(job);
+  EXPECT_EQ(coordinator->status(coordinator->submit(same).job_id()).warnings_size(), 1);
 }
 
 TEST_F(CoordinatorTest, SecondsBudgetOpensBlocksUntilTheBudgetIsSpent) {

@@ -55,7 +55,9 @@ TEST(FarmClient, CommandsSubmitWatchListStatusFetchAndWorkers) {
   Film local = testing::render_locally(scene, "sa", "stratified", 8, 3);
   EXPECT_TRUE(testing::same_bits(color, local.color));
   ASSERT_EQ(run_client(dir, {"workers", at}, &output), 0) << output;
-  EXPECT_NE(output.find("w1-w"), std::string::npos) << output;
+  // Listed under its --name (the worker's id), not a generated one.
+  EXPECT_NE(output.find("\nw" + std::string(23, ' ')), std::string::npos) << output;
+  EXPECT_EQ(output.find("w1-w"), std::string::npos) << output;
   EXPECT_NE(run_client(dir, {"status", "job-9", at}, &output), 0);
   EXPECT_NE(output.find("NOT_FOUND"), std::string::npos) << output;
 }

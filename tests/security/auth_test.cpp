@@ -1,16 +1,25 @@
 // The pieces of authentication without a server: the tokens file, the role of each method, the
 // decision for a call, bearer headers, loopback addresses, where a client's token comes from, and
-// the client refusing to send a token in plaintext to a remote host.
+// the client refusing to send a token in plaintext to a remote host. Then the HTTP side in
+// process (a coordinator and its HttpFrontend, no gRPC): every route without a token, with
+// another client's, its own, a viewer's, a worker's; tokens in the address carried on by the
+// pages; /metrics open only when asked; HTTPS with the coordinator's certificate.
 #if __has_include("penumbra/v1/farm.pb.h")
 #include "server/auth.h"
 
 #include <gtest/gtest.h>
+#include <httplib.h>
 #include <stdlib.h>
 
 #include <filesystem>
 #include <fstream>
 
+#include "proto/support/batch_client.h"
 #include "proto/support/farm_client.h"
+#include "proto/support/scene_packing.h"
+#include "security_test_support.h"
+#include "server/batch_manager.h"
+#include "server/http_frontend.h"
 
 namespace penumbra::farm {
 namespace {
@@ -208,6 +217,294 @@ TEST(ClientConnection, TokenFromFlagFileOrEnvironment) {
   EXPECT_THROW(resolve_token("", (dir / "missing").string()), std::runtime_error);
   ::unsetenv("PENUMBRA_TOKEN");
   EXPECT_EQ(resolve_token("", ""), "");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Roles, ViewerHasNoGrpcMethod) {
+  TokenTable table = TokenTable::parse("viewer wall wall-token-0123456789\n", "t");
+  ASSERT_EQ(table.find("wall-token-0123456789")->role, Role::viewer);
+  for (Role required : {Role::client, Role::worker, Role::admin})
+    EXPECT_FALSE(role_allows(Role::viewer, required));
+  AuthPolicy policy;
+  policy.tokens = std::make_shared<const TokenTable>(table);
+  grpc::Status status =
+      authorize_call(policy, "/penumbra.v1.Jobs/ListJobs", "Bearer wall-token-0123456789", false)
+          .status;
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_NE(status.error_message().find("has role viewer"), std::string::npos);
+}
+
+TEST(HttpAuth, DecisionForEveryRole) {
+  TokenTable table =
+      TokenTable::parse(std::string(kTokens) + "viewer wall wall-token-0123456789\n", "t");
+  auto decide = [&](std::optional<std::string_view> header,
+                    std::optional<std::string_view> parameter) {
+    return authorize_http(&table, header, parameter);
+  };
+  EXPECT_EQ(decide(std::nullopt, std::nullopt).status, 401);
+  EXPECT_EQ(decide("Basic alice-token-0123456789", std::nullopt).status, 401);
+  EXPECT_EQ(decide("Bearer nobody-0123456789abcdef", std::nullopt).status, 401);
+  EXPECT_EQ(decide(std::nullopt, "").status, 401);
+  HttpAuthorization alice = decide("Bearer alice-token-0123456789", std::nullopt);
+  EXPECT_EQ(alice.status, 200);
+  EXPECT_FALSE(alice.caller.sees_every_job);
+  EXPECT_EQ(alice.caller.client, "alice");
+  EXPECT_FALSE(alice.sees_farm);
+  EXPECT_FALSE(alice.token_from_query);
+  HttpAuthorization from_query = decide(std::nullopt, "alice-token-0123456789");
+  EXPECT_EQ(from_query.status, 200);
+  EXPECT_TRUE(from_query.token_from_query);
+  // The header wins over the parameter, even when it is malformed.
+  EXPECT_EQ(decide("Bearer nobody-0123456789abcdef", "alice-token-0123456789").status, 401);
+  HttpAuthorization viewer = decide("Bearer wall-token-0123456789", std::nullopt);
+  EXPECT_EQ(viewer.status, 200);
+  EXPECT_TRUE(viewer.caller.sees_every_job);
+  EXPECT_TRUE(viewer.sees_farm);
+  EXPECT_TRUE(decide("Bearer root-token-0123456789", std::nullopt).sees_farm);
+  HttpAuthorization worker = decide("Bearer worker-token-0123456789", std::nullopt);
+  EXPECT_EQ(worker.status, 403);
+  EXPECT_NE(worker.message.find("w1"), std::string::npos);
+  EXPECT_EQ(worker.message.find("worker-token"), std::string::npos);
+  // Authentication off: everything is open.
+  HttpAuthorization open = authorize_http(nullptr, std::nullopt, std::nullopt);
+  EXPECT_EQ(open.status, 200);
+  EXPECT_TRUE(open.caller.sees_every_job);
+  EXPECT_TRUE(open.sees_farm);
+}
+
+// A coordinator with a job and a batch of alice's and a job of bob's, its HTTP side with tokens.
+class HttpRoutes : public ::testing::Test {
+ protected:
+  static constexpr const char* kViewerToken = "viewer-wall-0a1b2c3d4e5f6789";
+
+  static void SetUpTestSuite() {
+    dir_ = new std::filesystem::path(testing::fresh_directory("http-auth"));
+    std::ofstream(*dir_ / "tokens.txt")
+        << "client alice " << testing::kAliceToken << "\nclient bob " << testing::kBobToken
+        << "\nworker w1 " << testing::kWorkerToken << "\nadmin root " << testing::kAdminToken
+        << "\nviewer wall " << kViewerToken << "\n";
+    tokens_ = new std::shared_ptr<const TokenTable>(
+        std::make_shared<const TokenTable>(TokenTable::load((*dir_ / "tokens.txt").string())));
+    CoordinatorOptions options;
+    options.data_dir = (*dir_ / "data").string();
+    coordinator_ = new Coordinator(options, parse_wire_package);
+    BatchManagerOptions batch_options;
+    batch_options.data_dir = options.data_dir;
+    batch_options.max_spp = options.max_spp;
+    batches_ = new BatchManager(*coordinator_, parse_wire_package, batch_options);
+    std::string scene = testing::write_scene(*dir_, 32, 24);
+    alice_job_ = new std::string(
+        coordinator_->submit(CallContext::of_client("alice"), testing::job_spec(scene, "sa", 4, 1))
+            .job_id());
+    bob_job_ = new std::string(
+        coordinator_->submit(CallContext::of_client("bob"), testing::job_spec(scene, "sa", 4, 2))
+            .job_id());
+    const std::string spec = R"({"format": "penumbra/batch@1", "name": "owned", "scene": ")" +
+                             scene + R"(", "methods": ["sa"], "budget": {"seconds": 1},
+        "reference": {"method": "sa", "spp": 2}, "repeats": 1})";
+    auto request = make_batch_request_from_text(spec, "owned.json", dir_->string(),
+                                                [](const std::string& name) { return name; });
+    alice_batch_ =
+        new std::string(batches_->submit(request, CallContext::of_client("alice")).batch_id());
+    HttpFrontendOptions http_options;
+    http_options.batches = batches_;
+    http_options.tokens = *tokens_;
+    http_ = new HttpFrontend(*coordinator_, http_options);
+  }
+  static void TearDownTestSuite() {
+    delete http_;
+    delete batches_;
+    delete coordinator_;
+    delete tokens_;
+    std::filesystem::remove_all(*dir_);
+    delete dir_;
+    delete alice_job_;
+    delete bob_job_;
+    delete alice_batch_;
+  }
+  // GET `path` with "Authorization: Bearer <token>" (none for an empty token).
+  static httplib::Result get(const std::string& path, const std::string& token = "") {
+    httplib::Client client(http_->host(), http_->port());
+    httplib::Headers headers;
+    if (!token.empty()) headers.emplace("Authorization", "Bearer " + token);
+    return client.Get(path, headers);
+  }
+  static int status(const std::string& path, const std::string& token = "") {
+    auto result = get(path, token);
+    return result ? result->status : 0;
+  }
+
+  static std::filesystem::path* dir_;
+  static std::shared_ptr<const TokenTable>* tokens_;
+  static Coordinator* coordinator_;
+  static BatchManager* batches_;
+  static HttpFrontend* http_;
+  static std::string *alice_job_, *bob_job_, *alice_batch_;
+};
+std::filesystem::path* HttpRoutes::dir_ = nullptr;
+std::shared_ptr<const TokenTable>* HttpRoutes::tokens_ = nullptr;
+Coordinator* HttpRoutes::coordinator_ = nullptr;
+BatchManager* HttpRoutes::batches_ = nullptr;
+HttpFrontend* HttpRoutes::http_ = nullptr;
+std::string* HttpRoutes::alice_job_ = nullptr;
+std::string* HttpRoutes::bob_job_ = nullptr;
+std::string* HttpRoutes::alice_batch_ = nullptr;
+
+TEST_F(HttpRoutes, EveryRouteButHealthNeedsAToken) {
+  const std::string job = *alice_job_;
+  for (const std::string& path :
+       {std::string("/"), std::string("/api/summary"), std::string("/api/jobs"), "/api/jobs/" + job,
+        "/api/jobs/" + job + "/preview.png", std::string("/api/workers"), "/jobs/" + job,
+        "/batches/" + *alice_batch_, std::string("/metrics"), std::string("/no-such-route")}) {
+    SCOPED_TRACE(path);
+    auto result = get(path);
+    ASSERT_TRUE(result);
+    EXPECT_EQ(result->status, 401);
+    EXPECT_EQ(result->get_header_value("WWW-Authenticate"), "Bearer realm=\"penumbra\"");
+    EXPECT_EQ(result->body.find(job + "\""), std::string::npos);  // no job's data
+    EXPECT_EQ(status(path, "nobody-0123456789abcdef"), 401);
+    EXPECT_EQ(status(path, testing::kWorkerToken), 403);
+    // A token in the wrong scheme is no token.
+    httplib::Client client(http_->host(), http_->port());
+    auto basic = client.Get(path, {{"Authorization", std::string("Basic ") + kViewerToken}});
+    ASSERT_TRUE(basic);
+    EXPECT_EQ(basic->status, 401);
+  }
+  auto health = get("/healthz");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  EXPECT_EQ(health->get_header_value("Referrer-Policy"), "no-referrer");
+}
+
+TEST_F(HttpRoutes, AClientSeesItsOwnJobsAndBatchesOnlyAViewerSeesAll) {
+  const std::string job = *alice_job_, bobs = *bob_job_, batch = *alice_batch_;
+  // One job's and one batch's routes: 404 for bob (the words of an unknown id), 200 for alice,
+  // the viewer and the admin.
+  for (const std::string& path : {"/api/jobs/" + job, "/api/jobs/" + job + "/preview.png",
+                                  "/jobs/" + job, "/batches/" + batch}) {
+    SCOPED_TRACE(path);
+    auto other = get(path, testing::kBobToken);
+    ASSERT_TRUE(other);
+    EXPECT_EQ(other->status, 404);
+    std::string unknown_path = path;
+    for (const std::string& id : {job, batch})
+      if (size_t at = unknown_path.find(id); at != std::string::npos)
+        unknown_path.replace(at, id.size(), id.substr(0, id.find('-')) + "-987654");
+    auto unknown = get(unknown_path, testing::kBobToken);
+    ASSERT_TRUE(unknown);
+    EXPECT_EQ(unknown->status, 404);
+    EXPECT_EQ(other->body.find("alice"), std::string::npos);
+    EXPECT_EQ(status(path, testing::kAliceToken), 200);
+    EXPECT_EQ(status(path, kViewerToken), 200);
+    EXPECT_EQ(status(path, testing::kAdminToken), 200);
+  }
+  // Lists: alice's jobs only for alice, both for the viewer; the dashboard likewise.
+  auto alice_list = get("/api/jobs", testing::kAliceToken);
+  ASSERT_TRUE(alice_list);
+  EXPECT_EQ(alice_list->status, 200);
+  EXPECT_NE(alice_list->body.find("\"" + job + "\""), std::string::npos);
+  EXPECT_EQ(alice_list->body.find("\"" + bobs + "\""), std::string::npos);
+  EXPECT_EQ(alice_list->body.find("\"bob\""), std::string::npos);
+  auto viewer_list = get("/api/jobs", kViewerToken);
+  ASSERT_TRUE(viewer_list);
+  EXPECT_NE(viewer_list->body.find("\"" + job + "\""), std::string::npos);
+  EXPECT_NE(viewer_list->body.find("\"" + bobs + "\""), std::string::npos);
+  auto bob_page = get("/", testing::kBobToken);
+  ASSERT_TRUE(bob_page);
+  EXPECT_EQ(bob_page->status, 200);
+  EXPECT_NE(bob_page->body.find("data-job-id=\"" + bobs + "\""), std::string::npos);
+  EXPECT_EQ(bob_page->body.find("data-job-id=\"" + job + "\""), std::string::npos);
+  auto wall = get("/", kViewerToken);
+  ASSERT_TRUE(wall);
+  EXPECT_NE(wall->body.find("data-job-id=\"" + job + "\""), std::string::npos);
+  EXPECT_NE(wall->body.find("data-job-id=\"" + bobs + "\""), std::string::npos);
+  // The farm's aggregate figures are any client's; /metrics (every job by id) is not.
+  EXPECT_EQ(status("/api/summary", testing::kBobToken), 200);
+  EXPECT_EQ(status("/api/workers", testing::kBobToken), 200);
+  EXPECT_EQ(status("/metrics", testing::kBobToken), 403);
+  EXPECT_EQ(status("/metrics", kViewerToken), 200);
+  EXPECT_EQ(status("/metrics", testing::kAdminToken), 200);
+}
+
+TEST_F(HttpRoutes, ATokenInTheAddressIsCarriedOnByThePages) {
+  const std::string job = *alice_job_;
+  httplib::Client client(http_->host(), http_->port());
+  const std::string query = std::string("?token=") + testing::kAliceToken;
+  auto page = client.Get("/jobs/" + job + query);
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("src=\"/api/jobs/" + job + "/preview.png" + query + "\""),
+            std::string::npos);
+  EXPECT_NE(page->body.find("<a href=\"/" + query + "\">dashboard</a>"), std::string::npos);
+  EXPECT_EQ(page->get_header_value("Referrer-Policy"), "no-referrer");
+  auto image = client.Get("/api/jobs/" + job + "/preview.png" + query);
+  ASSERT_TRUE(image);
+  EXPECT_EQ(image->status, 200);
+  EXPECT_EQ(image->get_header_value("Content-Type"), "image/png");
+  auto dashboard = client.Get("/" + query);
+  ASSERT_TRUE(dashboard);
+  EXPECT_EQ(dashboard->status, 200);
+  EXPECT_NE(
+      dashboard->body.find("/preview.png?passes=0&amp;token=" + std::string(testing::kAliceToken)),
+      std::string::npos);
+  auto batch = client.Get("/batches/" + *alice_batch_ + query);
+  ASSERT_TRUE(batch);
+  EXPECT_EQ(batch->status, 200);
+  EXPECT_NE(batch->body.find("<a href=\"/" + query + "\">dashboard</a>"), std::string::npos);
+  // Without one the links stay bare; another client's token in the address is 404.
+  auto bare = get("/jobs/" + job, testing::kAliceToken);
+  ASSERT_TRUE(bare);
+  EXPECT_EQ(bare->body.find("token="), std::string::npos);
+  auto other = client.Get("/jobs/" + job + "?token=" + testing::kBobToken);
+  ASSERT_TRUE(other);
+  EXPECT_EQ(other->status, 404);
+  // Nothing but GET is served (the side changes nothing).
+  auto post = client.Post("/api/jobs" + query, "", "application/json");
+  ASSERT_TRUE(post);
+  EXPECT_NE(post->status, 200);
+}
+
+TEST(HttpAuth, OpenMetricsAndHttpsWithTheCoordinatorsCertificate) {
+  auto dir = testing::fresh_directory("http-tls");
+  auto certificates = testing::make_test_certificates(dir / "certs");
+  auto tokens = std::make_shared<const TokenTable>(TokenTable::parse(kTokens, "t"));
+  CoordinatorOptions options;
+  options.data_dir = (dir / "data").string();
+  Coordinator coordinator(options, parse_wire_package);
+  HttpFrontendOptions http_options;
+  http_options.tokens = tokens;
+  http_options.open_metrics = true;
+  http_options.tls_cert = certificates.server_cert.string();
+  http_options.tls_key = certificates.server_key.string();
+  HttpFrontend http(coordinator, http_options);
+  httplib::SSLClient client(http.host(), http.port());
+  client.set_ca_cert_path(certificates.ca.string().c_str());
+  client.enable_server_certificate_verification(true);
+  auto metrics = client.Get("/metrics");  // open: no token
+  ASSERT_TRUE(metrics) << httplib::to_string(metrics.error());
+  EXPECT_EQ(metrics->status, 200);
+  EXPECT_NE(metrics->body.find("penumbra_queue_depth"), std::string::npos);
+  auto jobs = client.Get("/api/jobs");
+  ASSERT_TRUE(jobs);
+  EXPECT_EQ(jobs->status, 401);
+  auto with_token = client.Get("/api/jobs", {{"Authorization", "Bearer alice-token-0123456789"}});
+  ASSERT_TRUE(with_token);
+  EXPECT_EQ(with_token->status, 200);
+  // Plain HTTP to the HTTPS port gets no answer.
+  httplib::Client plain(http.host(), http.port());
+  plain.set_read_timeout(std::chrono::seconds(2));
+  auto refused = plain.Get("/healthz");
+  EXPECT_TRUE(!refused || refused->status != 200);
+  // A certificate the client does not trust is refused by the client.
+  httplib::SSLClient untrusting(http.host(), http.port());
+  untrusting.set_ca_cert_path((dir / "certs" / "rogue-ca.pem").string().c_str());
+  untrusting.enable_server_certificate_verification(true);
+  EXPECT_FALSE(untrusting.Get("/healthz"));
+  http.stop();
+  // A certificate without its key is refused at start-up.
+  HttpFrontendOptions half;
+  half.tls_cert = certificates.server_cert.string();
+  EXPECT_THROW(HttpFrontend(coordinator, half), std::runtime_error);
   std::filesystem::remove_all(dir);
 }
 

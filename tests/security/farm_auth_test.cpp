@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "penumbra/version.h"
+#include "proto/support/batch_client.h"
 #include "security_test_support.h"
 
 namespace penumbra::farm {
@@ -140,6 +141,81 @@ TEST_F(FarmAuth, OwnerIsTheAuthenticatedCaller) {
   EXPECT_EQ(root.status(admin_job).owner(), "root");
   alice.cancel(job);
   root.cancel(admin_job);
+}
+
+// Another client's job or batch is NOT_FOUND for status, watch, cancel, fetch and as a
+// reference, with the very message of an id nobody holds (its existence does not leak); list
+// shows the caller's own only; an admin sees and may cancel every job.
+TEST_F(FarmAuth, AnotherClientsJobsAndBatchesAreNotFound) {
+  FarmClient alice = client(testing::kAliceToken);
+  FarmClient bob = client(testing::kBobToken);
+  std::string job = alice.submit(testing::job_spec(*scene_, "sa", 4, 1)).job_id();
+  std::string bobs = bob.submit(testing::job_spec(*scene_, "sa", 4, 2)).job_id();
+  auto message_of = [](auto&& call) {
+    try {
+      call();
+    } catch (const FarmCallError& error) {
+      return std::to_string(int(error.code())) + " " + error.what();
+    }
+    return std::string("OK");
+  };
+  const std::string unknown = "job-999999";
+  for (const std::string& id : {job, unknown}) {
+    SCOPED_TRACE(id);
+    EXPECT_EQ(code_of([&] { bob.status(id); }), StatusCode::NOT_FOUND);
+    EXPECT_EQ(code_of([&] { bob.cancel(id); }), StatusCode::NOT_FOUND);
+    EXPECT_EQ(code_of([&] { bob.fetch(id); }), StatusCode::NOT_FOUND);
+    EXPECT_EQ(code_of([&] { bob.wait(id, 10s); }), StatusCode::NOT_FOUND);
+    v1::JobSpec referencing = testing::job_spec(*scene_, "sa", 4, 3);
+    referencing.set_reference_job(id);
+    EXPECT_EQ(code_of([&] { bob.submit(referencing); }), StatusCode::NOT_FOUND);
+  }
+  // The same words as for an id nobody holds, but for the id itself.
+  auto replace_id = [&](std::string text) {
+    for (size_t at; (at = text.find(job)) != std::string::npos;) text.replace(at, job.size(), "ID");
+    for (size_t at; (at = text.find(unknown)) != std::string::npos;)
+      text.replace(at, unknown.size(), "ID");
+    return text;
+  };
+  EXPECT_EQ(replace_id(message_of([&] { bob.status(job); })),
+            replace_id(message_of([&] { bob.status(unknown); })));
+  EXPECT_EQ(replace_id(message_of([&] { bob.cancel(job); })),
+            replace_id(message_of([&] { bob.cancel(unknown); })));
+  // Nothing happened to alice's job; each client lists its own jobs only.
+  EXPECT_EQ(alice.status(job).state(), v1::JOB_STATE_QUEUED);
+  for (const v1::JobStatus& listed : bob.list()) EXPECT_EQ(listed.owner(), "bob");
+  for (const v1::JobStatus& listed : alice.list()) EXPECT_EQ(listed.owner(), "alice");
+  auto lists = [](FarmClient& who, const std::string& id) {
+    for (const v1::JobStatus& listed : who.list())
+      if (listed.job_id() == id) return true;
+    return false;
+  };
+  EXPECT_TRUE(lists(alice, job));
+  EXPECT_FALSE(lists(bob, job));
+  EXPECT_TRUE(lists(bob, bobs));
+  // An admin sees both and may cancel either.
+  FarmClient root = client(testing::kAdminToken);
+  EXPECT_TRUE(lists(root, job));
+  EXPECT_TRUE(lists(root, bobs));
+  EXPECT_EQ(root.cancel(bobs), v1::JOB_STATE_CANCELLED);
+  EXPECT_EQ(alice.cancel(job), v1::JOB_STATE_CANCELLED);
+
+  // Batches: alice's batch is NOT_FOUND for bob (no worker runs here: it waits for its
+  // reference).
+  const std::string spec = R"({"format": "penumbra/batch@1", "name": "owned", "scene": ")" +
+                           *scene_ + R"(", "methods": ["sa"], "budget": {"seconds": 1},
+      "reference": {"method": "sa", "spp": 2}, "repeats": 1})";
+  auto request = make_batch_request_from_text(spec, "owned.json", dir_->string(),
+                                              [](const std::string& name) { return name; });
+  BatchClient alice_batches(connection_to(coordinator_->address(), testing::kAliceToken));
+  BatchClient bob_batches(connection_to(coordinator_->address(), testing::kBobToken));
+  std::string batch = alice_batches.submit(request).batch_id();
+  EXPECT_EQ(code_of([&] { bob_batches.status(batch); }), StatusCode::NOT_FOUND);
+  EXPECT_EQ(code_of([&] { bob_batches.cancel(batch); }), StatusCode::NOT_FOUND);
+  EXPECT_EQ(code_of([&] { bob_batches.fetch_reference(batch); }), StatusCode::NOT_FOUND);
+  for (const v1::BatchStatus& listed : bob_batches.list()) EXPECT_NE(listed.batch_id(), batch);
+  EXPECT_EQ(alice_batches.status(batch).owner(), "alice");
+  EXPECT_EQ(alice_batches.cancel(batch).state(), v1::BATCH_STATE_CANCELLED);
 }
 
 TEST_F(FarmAuth, WorkerWithWorkerTokenRendersAndOneWithClientTokenIsRefused) {

@@ -11,6 +11,7 @@
 #include <grpcpp/server_builder.h>
 #include <gtest/gtest.h>
 
+#include "proto/support/scene_chunks.h"
 #include "security_test_support.h"
 
 namespace penumbra::farm {
@@ -110,6 +111,24 @@ class FakeWorkersService final : public v1::Workers::Service {
     std::lock_guard lock(mutex);
     scene_requests.push_back(request->scene_hash());
     *response = package;
+    return grpc::Status::OK;
+  }
+  // The package in chunks, under whatever hash is asked for (a coordinator that lies: the
+  // worker must find out from the content).
+  grpc::Status GetSceneManifest(grpc::ServerContext*, const v1::GetSceneRequest* request,
+                                v1::SceneManifest* response) override {
+    std::lock_guard lock(mutex);
+    scene_requests.push_back(request->scene_hash());
+    *response = make_scene_manifest(request->scene_hash(), serialize_package(package), 4096);
+    return grpc::Status::OK;
+  }
+  grpc::Status GetSceneChunk(grpc::ServerContext*, const v1::GetSceneChunkRequest* request,
+                             v1::SceneChunk* response) override {
+    std::lock_guard lock(mutex);
+    scene_requests.push_back(request->scene_hash());
+    const std::string bytes = serialize_package(package);
+    response->set_index(request->index());
+    response->set_data(bytes.substr(size_t(request->index()) * 4096, 4096));
     return grpc::Status::OK;
   }
   grpc::Status CompleteTask(grpc::ServerContext*, const v1::CompleteTaskRequest* request,

@@ -102,6 +102,22 @@ TEST(LineChart, SvgIsWritten) {
   EXPECT_GT(text.str().size(), 1000u);
 }
 
+// A log axis always holds two decades, so that it has two labels: data within one decade
+// (a time chart of 0.3 to 0.8 s) is drawn over the decades around it; wider data is left alone.
+TEST(LineChart, LogAxesHoldAtLeastTwoDecades) {
+  auto decades = [](std::pair<double, double> range) {
+    return std::floor(range.second) - std::ceil(range.first) + 1;
+  };
+  EXPECT_EQ(log_axis_range(std::log10(0.3), std::log10(0.8)), std::make_pair(-1.0, 0.0));
+  EXPECT_EQ(log_axis_range(-3.2, -3.1), std::make_pair(-4.0, -3.0));
+  EXPECT_EQ(log_axis_range(0.2, 1.7), std::make_pair(0.0, 2.0));
+  EXPECT_EQ(log_axis_range(-3.2, -1.1), std::make_pair(-3.2, -1.1));
+  EXPECT_EQ(log_axis_range(2.0, 2.0), std::make_pair(2.0, 3.0));
+  for (double low = -5; low < 5; low += 0.37)
+    for (double span = 0; span < 3; span += 0.29)
+      EXPECT_GE(decades(log_axis_range(low, low + span)), 2) << low << " " << span;
+}
+
 TEST(LineChart, LinearAxesAndSinglePointSeries) {
   ChartSpec spec;
   spec.title = "one point";

@@ -17,6 +17,8 @@
 namespace penumbra {
 namespace {
 
+using namespace occluder_meshes;
+
 constexpr double kTolerance = 1e-6;
 
 class Random {
@@ -584,6 +586,217 @@ TEST(LineQuery, TraversalCullsMostTriangles) {
   double tested_per_query = static_cast<double>(stats.triangles_tested) / queries;
   EXPECT_LT(tested_per_query, 0.05 * mesh.triangle_count());
   EXPECT_GT(stats.cuts, 0u);
+}
+
+// The same intervals bit for bit (the BVH's culling is conservative, the leaves run the same
+// exact test as the brute force, and subtracting closed cuts does not depend on their order).
+void expect_identical_intervals(const IntervalList& actual, const IntervalList& expected,
+                                const char* what) {
+  ASSERT_EQ(actual.size(), expected.size()) << what;
+  for (size_t i = 0; i < actual.size(); ++i) {
+    EXPECT_EQ(actual[i].lo, expected[i].lo) << what << " piece " << i;
+    EXPECT_EQ(actual[i].hi, expected[i].hi) << what << " piece " << i;
+  }
+}
+
+// Rotates the mesh about the origin (the same vertex gives the same bits: closed stays closed).
+TriangleMesh rotated(TriangleMesh mesh, const Vec3& axis, double angle) {
+  const Frame frame = Frame::from_normal(normalize(axis));
+  const double c = std::cos(angle), s = std::sin(angle);
+  for (Vec3& p : mesh.positions) {
+    Vec3 local = frame.to_local(p);
+    p = frame.to_world({c * local.x - s * local.y, s * local.x + c * local.y, local.z});
+  }
+  return mesh;
+}
+
+// A soup meant to break conservative culling: long thin slanted bars (split into pieces by the
+// build), slivers (one vertex within ~1e-7 of the opposite edge), a huge triangle through the
+// query region, tiny triangles, and a slanted closed box.
+TriangleMesh adversarial_mesh(Random& random) {
+  TriangleMesh mesh;
+  for (int i = 0; i < 40; ++i) {
+    // A bar: two triangles 3 long and 0.01 wide, in a random slanted direction.
+    Vec3 center = random.in_box({-1, -1, -1}, {1, 1, 1});
+    Vec3 along = 1.5 * random.direction(),
+         across = 0.005 * normalize(cross(along, random.direction()));
+    uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+    mesh.positions.insert(mesh.positions.end(), {center - along - across, center + along - across,
+                                                 center + along + across, center - along + across});
+    mesh.add_triangle(base, base + 1, base + 2);
+    mesh.add_triangle(base, base + 2, base + 3);
+  }
+  for (int i = 0; i < 40; ++i) {
+    // A sliver: the third vertex ~1e-7 off the segment between the first two.
+    Vec3 p = random.in_box({-1, -1, -1}, {1, 1, 1}), q = p + random.direction();
+    Vec3 r = p + random.uniform(0.1, 0.9) * (q - p) + 1e-7 * random.direction();
+    uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+    mesh.positions.insert(mesh.positions.end(), {p, q, r});
+    mesh.add_triangle(base, base + 1, base + 2);
+  }
+  {
+    // A huge triangle through the region, and tiny ones.
+    uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+    mesh.positions.insert(mesh.positions.end(),
+                          {{-1e4, 0.3, -1e4}, {1e4, -0.2, -1e4}, {0, 0.1, 2e4}});
+    mesh.add_triangle(base, base + 1, base + 2);
+    mesh.append(random_triangles_mesh(200, {-1, -1, -1}, {1, 1, 1}, 1e-5, 5));
+  }
+  mesh.append(rotated(box_mesh({-0.3, -0.3, -0.3}, {0.3, 0.3, 0.3}, 3), {1, 2, 3}, 0.7));
+  return mesh;
+}
+
+TEST(LineQuery, AdversarialPlanesThroughVerticesAndEdgesMatchBruteForceExactly) {
+  Random random(101);
+  TriangleMesh mesh = adversarial_mesh(random);
+  // Every build (pre-split or not, every quality, small and large leaves) against the brute
+  // force, on shadow triangles whose planes pass through vertices and along edges.
+  std::vector<LineQueryOptions> builds;
+  for (bool split : {true, false}) {
+    for (LineQueryBuildQuality quality :
+         {LineQueryBuildQuality::Low, LineQueryBuildQuality::Medium, LineQueryBuildQuality::High}) {
+      LineQueryOptions options;
+      options.split_long_triangles = split;
+      options.build_quality = quality;
+      options.max_leaf_size = quality == LineQueryBuildQuality::Low ? 1 : 4;
+      builds.push_back(options);
+    }
+  }
+  std::vector<LineQuery> queries;
+  for (const LineQueryOptions& options : builds)
+    queries.emplace_back(mesh.positions, mesh.indices, options);
+  auto vertex = [&](size_t triangle, int k) {
+    return mesh.positions[mesh.indices[3 * triangle + k]];
+  };
+  int partially_visible = 0;
+  const int trials = 900;
+  for (int trial = 0; trial < trials; ++trial) {
+    Vec3 x = random.in_box({-1.5, -1.5, -1.5}, {1.5, 1.5, 1.5});
+    Vec3 a, b;
+    const size_t t = random.index(mesh.triangle_count());
+    const int k = static_cast<int>(random.index(3));
+    switch (trial % 5) {
+      case 0:  // random
+        a = random.in_box({-2, -2, -2}, {2, 2, 2});
+        b = random.in_box({-2, -2, -2}, {2, 2, 2});
+        break;
+      case 1: {  // the shadow plane through a vertex
+        Vec3 v = vertex(t, k);
+        a = x + random.uniform(1.2, 3) * (random.in_box({-1, -1, -1}, {1, 1, 1}) - x);
+        b = x + random.uniform(1.2, 3) * (v - x) + random.uniform(-0.5, 0.5) * (a - x);
+        break;
+      }
+      case 2: {  // the shadow plane along an edge, the segment's ends behind its vertices
+        Vec3 v0 = vertex(t, k), v1 = vertex(t, (k + 1) % 3);
+        a = x + random.uniform(1.2, 3) * (v0 - x);
+        b = x + random.uniform(1.2, 3) * (v1 - x);
+        break;
+      }
+      case 3: {  // x on a vertex of one triangle, the segment anywhere
+        x = vertex(t, k);
+        a = random.in_box({-2, -2, -2}, {2, 2, 2});
+        b = random.in_box({-2, -2, -2}, {2, 2, 2});
+        break;
+      }
+      default: {  // x on an edge, the segment behind another triangle's vertices
+        x = 0.5 * (vertex(t, k) + vertex(t, (k + 1) % 3));
+        const size_t u = random.index(mesh.triangle_count());
+        a = x + random.uniform(1.2, 3) * (vertex(u, 0) - x);
+        b = x + random.uniform(1.2, 3) * (vertex(u, 1) - x);
+        break;
+      }
+    }
+    IntervalList expected;
+    visible_intervals_brute_force(mesh.positions, mesh.indices, x, a, b, expected);
+    for (size_t q = 0; q < queries.size(); ++q) {
+      IntervalList actual;
+      queries[q].visible_intervals(x, a, b, actual);
+      expect_identical_intervals(actual, expected, "adversarial");
+      if (::testing::Test::HasFailure()) {
+        ADD_FAILURE() << "trial " << trial << " build " << q;
+        return;
+      }
+    }
+    partially_visible += !expected.fully_occluded() && expected.visible_length() < 1;
+  }
+  EXPECT_GT(partially_visible, trials / 5);
+}
+
+TEST(LineQuery, PreSplitTestsFewerTrianglesAndGivesTheSameBits) {
+  // Two lattices of long bars rotated about the vertical (no bar along an axis) over a floor:
+  // without pre-splitting every bar's box spans the lattice's width.
+  TriangleMesh mesh = floor_grid(3, 0, 2);
+  for (int layer = 0; layer < 2; ++layer) {
+    TriangleMesh lattice;
+    for (int i = -5; i <= 5; ++i) {
+      lattice.append(box_mesh({-2.0, 0.5 + 0.4 * layer, 0.3 * i - 0.02},
+                              {2.0, 0.52 + 0.4 * layer, 0.3 * i + 0.02}));
+      lattice.append(box_mesh({0.3 * i - 0.02, 0.5 + 0.4 * layer, -2.0},
+                              {0.3 * i + 0.02, 0.52 + 0.4 * layer, 2.0}));
+    }
+    mesh.append(rotated(lattice, {0, 1, 0}, layer == 0 ? 0.35 : -0.6));
+  }
+  LineQueryOptions whole;
+  whole.split_long_triangles = false;
+  LineQuery split_query(mesh.positions, mesh.indices);
+  LineQuery whole_query(mesh.positions, mesh.indices, whole);
+  Random random(111);
+  LineQueryStats split_stats, whole_stats;
+  for (int trial = 0; trial < 400; ++trial) {
+    Vec3 x = {random.uniform(-2, 2), 0, random.uniform(-2, 2)};
+    Vec3 a = random.in_box({-0.5, 2.2, -0.5}, {0.5, 2.2, 0.5});
+    Vec3 b = a + Vec3(random.uniform(0.2, 0.5), 0, random.uniform(-0.2, 0.2));
+    IntervalList split_answer, whole_answer;
+    split_query.visible_intervals(x, a, b, split_answer, &split_stats);
+    whole_query.visible_intervals(x, a, b, whole_answer, &whole_stats);
+    expect_identical_intervals(split_answer, whole_answer, "pre-split vs whole");
+    if (trial % 20 == 0)
+      expect_identical_intervals(split_answer, brute_force(mesh, x, a, b),
+                                 "pre-split vs brute force");
+  }
+  EXPECT_GT(split_stats.cuts, 400u);
+  EXPECT_LT(split_stats.triangles_tested, whole_stats.triangles_tested / 2);
+}
+
+TEST(LineQuery, SlantedClosedMeshesOccludeEverythingWhenPreSplit) {
+  // Closed meshes whose faces are long and slanted (so the build splits them): a long rotated
+  // box and a rotated UV sphere squashed into a disc. From x the segment lies behind the mesh's
+  // core: nothing may stay visible.
+  Random random(121);
+  int configurations = 0;
+  for (int mesh_index = 0; mesh_index < 4; ++mesh_index) {
+    TriangleMesh mesh;
+    if (mesh_index % 2 == 0) {
+      mesh = rotated(box_mesh({-3, -0.2, -0.2}, {3, 0.2, 0.2}, 1 + mesh_index), random.direction(),
+                     random.uniform(0.3, 1.2));
+    } else {
+      mesh = uv_sphere_mesh({0, 0, 0}, 1, 12, 24);
+      for (Vec3& p : mesh.positions) p = {3 * p.x, 0.3 * p.y, 3 * p.z};
+      mesh = rotated(mesh, random.direction(), random.uniform(0.3, 1.2));
+    }
+    LineQuery line_query(mesh.positions, mesh.indices);
+    for (int trial = 0; trial < 300; ++trial) {
+      // Through a point near the centre (inside the mesh's core, radius 0.1) along a random
+      // direction, a thin shadow triangle: x in front, the segment behind.
+      Vec3 core = 0.1 * random.uniform() * random.direction();
+      Vec3 direction = random.direction();
+      Vec3 x = core + random.uniform(4, 8) * direction;
+      Vec3 side = normalize(cross(direction, random.direction()));
+      Vec3 behind = core - random.uniform(4, 8) * direction;
+      // Half-width so small that every ray from x to the segment passes within 0.1 + 0.05 of
+      // the centre (inside both meshes).
+      double half = 0.04 * length(behind - x) / length(core - x);
+      Vec3 a = behind - half * side, b = behind + half * side;
+      IntervalList visible = query(line_query, x, a, b);
+      EXPECT_TRUE(visible.fully_occluded())
+          << "mesh " << mesh_index << " trial " << trial << " visible " << visible.visible_length();
+      if (trial % 10 == 0) {
+        EXPECT_TRUE(brute_force(mesh, x, a, b).fully_occluded());
+      }
+      ++configurations;
+    }
+  }
+  EXPECT_EQ(configurations, 1200);
 }
 
 TEST(LineQuery, OccludedAgreesWithBruteForceRays) {

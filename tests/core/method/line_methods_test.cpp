@@ -12,21 +12,10 @@
 #include "core/lines/line_query.h"
 #include "core/math/lambert_polygon.h"
 #include "core/method/direct_lighting.h"
+#include "tests/support/line_query_visibility.h"
 
 namespace penumbra {
 namespace {
-
-class QueryVisibility : public Visibility {
- public:
-  explicit QueryVisibility(const LineQuery& query) : query_(query) {}
-  bool occluded(const Vec3& from, const Vec3&, const Vec3& to) const override {
-    return query_.occluded(from, to);
-  }
-  const LineQuery* line_query() const override { return &query_; }
-
- private:
-  const LineQuery& query_;
-};
 
 Light quad_light(Vec3 origin, Vec3 edge1, Vec3 edge2, Rgb radiance) {
   Light light;
@@ -84,7 +73,7 @@ Estimate run(const Scene& scene, const char* method, const ShadingPoint& sp, Pat
              int trials, int multiplier = 1) {
   DirectLighting direct(scene, parse_method(method));
   LineQuery query(scene);
-  QueryVisibility visibility(query);
+  testing::LineQueryVisibility visibility(query);
   double sum = 0, sum_sq = 0;
   for (int t = 0; t < trials; ++t) {
     double value = direct.estimate(sp, visibility, pattern, {42, 0, uint32_t(t), 0}, multiplier).y;
@@ -255,7 +244,7 @@ TEST(LineMethods, FiniteInDegenerateConfigurations) {
   for (const Case& c : cases) {
     Scene scene = test_scene(true, c.light);
     LineQuery query(scene);
-    QueryVisibility visibility(query);
+    testing::LineQueryVisibility visibility(query);
     ShadingPoint sp = c.point;
     sp.material = &scene.materials[0];
     for (const char* method : kLineMethods) {

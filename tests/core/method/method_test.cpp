@@ -10,9 +10,9 @@ namespace {
 TEST(MethodGrammar, ParsesEveryFormOfTheContract) {
   MethodSpec m = parse_method("bsdf+3*line-sa:v");
   ASSERT_EQ(m.terms.size(), 2u);
-  EXPECT_EQ(m.terms[0].strategy, StrategyKind::Bsdf);
+  EXPECT_EQ(strategy_name(m.terms[0].strategy), "bsdf");
   EXPECT_EQ(m.terms[0].count, 1);
-  EXPECT_EQ(m.terms[1].strategy, StrategyKind::LineSolidAngle);
+  EXPECT_EQ(strategy_name(m.terms[1].strategy), "line-sa");
   EXPECT_EQ(m.terms[1].count, 3);
   EXPECT_EQ(m.terms[1].direction, LineDirection::V);
   EXPECT_EQ(m.combine, Combine::Balance);  // default with more than one term

@@ -1,7 +1,7 @@
 // Peters' solid angle sampling of polygons (Peters 2021, Sec. 5): van Oosterom & Strackee's
 // solid angle against quadrature, samples inside the polygon, tiny distant lights (Fig. 7).
-// The distribution itself is chi-square tested through PetersSolidAngleStrategy in
-// polygon_strategies_test.cpp.
+// The distribution itself is chi-square tested through SolidAngleStrategy in
+// tests/core/strategies/polygon_strategies_test.cpp.
 
 #include "core/polygon/solid_angle_polygon.h"
 

@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "core/math/lambert_polygon.h"
 #include "core/render/film.h"
@@ -144,6 +145,35 @@ TEST(Probe, UnoccludedPointMatchesTheClosedFormAndVarianceFallsWithN) {
   std::string json = probe_result_json(result);
   EXPECT_NE(json.find("penumbra/probe-result@1"), std::string::npos);
   EXPECT_NE(json.find("seconds_per_estimate"), std::string::npos);
+  // Each point says what it is and its convergence slope (least squares over the four n).
+  auto document = nlohmann::json::parse(json);
+  const auto& point = document["points"][0];
+  EXPECT_EQ(point["position"], nlohmann::json::array({0, 0.46, 0}));
+  EXPECT_EQ(point["material"], "white");
+  ASSERT_TRUE(point["variance_slope"][0].is_number());
+  EXPECT_NEAR(point["variance_slope"][0].get<double>(), -1.0, 0.2);
+  // The fit itself: exactly -1 for variance 1/n, undefined for one run or zero variances.
+  std::vector<ProbeRun> exact(3);
+  for (int k = 0; k < 3; ++k) {
+    exact[k].n = 1 << (2 * k);
+    exact[k].variance = Rgb(1.0 / exact[k].n, 0, 2.0 / exact[k].n);
+  }
+  EXPECT_NEAR(*variance_slope(exact, 0), -1.0, 1e-12);
+  EXPECT_FALSE(variance_slope(exact, 1).has_value());
+  EXPECT_FALSE(variance_slope({exact[0]}, 2).has_value());
+}
+
+TEST(Probe, PixelEntriesNameTheirPixel) {
+  auto scene = test_scene();
+  ProbeSpec probe = parse_probe(R"({"format": "penumbra/probe@1", "pixels": [[3, 5]],
+      "points": [{"position": [0, 0.46, 0], "normal": [0, 1, 0], "wo": [0, 1, 1], "material": "white"}]})");
+  std::vector<int> counts{1, 2};
+  auto document = nlohmann::json::parse(
+      probe_result_json(run_probe(scene, probe, "sa", Pattern::Random, counts, 4, 1)));
+  ASSERT_EQ(document["points"].size(), 2u);
+  EXPECT_EQ(document["points"][0]["pixel"], nlohmann::json::array({3, 5}));
+  EXPECT_FALSE(document["points"][0].contains("position"));
+  EXPECT_EQ(document["points"][1]["material"], "white");
 }
 
 TEST(Probe, BadInputGetsItsError) {

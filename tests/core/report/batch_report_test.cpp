@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "core/image/metrics.h"
+#include "core/image/noise_corrected_mrse.h"
 #include "core/render/local_render.h"
 #include "core/report/batch_charts.h"
 #include "core/report/batch_figure.h"
@@ -93,7 +94,8 @@ class BatchReportTest : public ::testing::Test {
     RenderBudget budget;
     budget.spp = 256;
     LocalRenderResult reference = render_local(reference_renderer, budget, 2);
-    write_exr((batch_dir_ / "reference.exr").string(), reference.film.color, nullptr, {});
+    write_exr((batch_dir_ / "reference.exr").string(), reference.film.color,
+              &reference.film.variance, {});
 
     nlohmann::json regions = nlohmann::json::array();
     for (const auto& [name, rect] : kRegions)
@@ -103,7 +105,7 @@ class BatchReportTest : public ::testing::Test {
       std::string label, method;
       int repeats;
     };
-    for (const MethodPlan& plan : {MethodPlan{"sa", "sa", 2}, MethodPlan{"bsdf+sa", "bsdf+sa", 1},
+    for (const MethodPlan& plan : {MethodPlan{"sa", "sa", 3}, MethodPlan{"bsdf+sa", "bsdf+sa", 2},
                                    MethodPlan{"refused", "no-such-strategy", 1}}) {
       nlohmann::json method = {{"label", plan.label},
                                {"method", plan.method},
@@ -194,8 +196,10 @@ TEST_F(BatchReportTest, TableNumbersAreTheMetricsOfTheExrs) {
   write_batch_report(batch_dir_, out);
 
   BatchResult result = read_batch_result(batch_dir_);
-  Image reference = read_exr((batch_dir_ / "reference.exr").string());
+  Image reference_variance;
+  Image reference = read_exr((batch_dir_ / "reference.exr").string(), nullptr, &reference_variance);
   nlohmann::json table = nlohmann::json::parse(read_text(out / "table.json"));
+  EXPECT_EQ(table["baseline"], "sa");
   ASSERT_EQ(table["regions"], nlohmann::json({"image", "corner", "penumbra"}));
   // sa: 2 rows (4 and 16 spp) of 2 repeats; bsdf+sa: 2 rows of 1; refused: 1 row.
   ASSERT_EQ(table["rows"].size(), 5u);
@@ -224,40 +228,64 @@ TEST_F(BatchReportTest, TableNumbersAreTheMetricsOfTheExrs) {
       seconds.push_back(run.compute_seconds);
     }
     ASSERT_EQ(row["repeats"].get<size_t>(), seconds.size());
-    EXPECT_EQ(row["repeats"].get<int>(), row["label"] == "sa" ? 2 : 1);
+    EXPECT_EQ(row["repeats"].get<int>(), row["label"] == "sa" ? 3 : 2);
     for (const auto& [region, list] : values) {
       double mean = 0;
       for (double v : list) mean += v;
       mean /= double(list.size());
-      double std = 0;
-      if (list.size() == 2) std = std::abs(list[0] - list[1]) / std::sqrt(2.0);
+      double squares = 0;
+      for (double v : list) squares += (v - mean) * (v - mean);
+      const double std = std::sqrt(squares / double(list.size() - 1));
       EXPECT_LE(relative_difference(row["mrse"][region]["mean"], mean), 1e-12) << region;
       EXPECT_LE(std::abs(row["mrse"][region]["std"].get<double>() - std), 1e-12 * mean) << region;
       EXPECT_GT(mean, 0) << region;
+      // Corrected: the plain mean less the reference's term, mean of s^2 / (r^2 + eps).
+      const Region rect = region == "image" ? Region{0, 0, 48, 40} : kRegions.at(region);
+      const double term = reference_noise_mrse(reference, reference_variance, rect);
+      EXPECT_GT(term, 0) << region;
+      const nlohmann::json& cell = row["mrse_corrected"][region];
+      EXPECT_LE(relative_difference(cell["mean"], mean - term), 1e-9) << region;
+      EXPECT_LT(cell["lower"].get<double>(), cell["mean"].get<double>()) << region;
+      EXPECT_GT(cell["upper"].get<double>(), cell["mean"].get<double>()) << region;
+      double share = 0;
+      for (double v : list) share += term / v / double(list.size());
+      EXPECT_NEAR(cell["reference_share"].get<double>(), share, 1e-9) << region;
+      EXPECT_EQ(cell["reference_flagged"].get<bool>(), share > 0.1) << region;
     }
-    EXPECT_LE(
-        relative_difference(row["compute_seconds"]["mean"], (seconds[0] + seconds.back()) / 2),
-        1e-12);
+    double seconds_mean = 0;
+    for (double v : seconds) seconds_mean += v / double(seconds.size());
+    EXPECT_LE(relative_difference(row["compute_seconds"]["mean"], seconds_mean), 1e-12);
     ++rows_checked;
   }
   EXPECT_EQ(rows_checked, 4);
 
-  // Best per column within each spp group: the lowest MRSE is marked, the other not.
+  // Winners per column within each spp group: marked exactly when the pairwise comparison (3
+  // and 2 repeats: 2 pairs) says one row beats the other at 95%.
   for (std::string group : {"4 spp", "16 spp"}) {
     for (std::string region : {"image", "penumbra", "corner"}) {
       std::vector<const nlohmann::json*> rows;
       for (const nlohmann::json& row : table["rows"])
         if (row["comparison_group"] == group) rows.push_back(&row);
       ASSERT_EQ(rows.size(), 2u);
-      double a = (*rows[0])["mrse"][region]["mean"], b = (*rows[1])["mrse"][region]["mean"];
+      const nlohmann::json* pair = nullptr;
+      for (const nlohmann::json& entry : table["pairwise"])
+        if (entry["group"] == group && entry["region"] == region) pair = &entry;
+      ASSERT_NE(pair, nullptr) << group << " " << region;
+      EXPECT_EQ((*pair)["pairs"], 2);
       auto marked = [&](const nlohmann::json& row) {
         for (const auto& column : row["best"])
           if (column == "mrse:" + region) return true;
         return false;
       };
-      EXPECT_EQ(marked(*rows[0]), a <= b) << group << " " << region;
-      EXPECT_EQ(marked(*rows[1]), b <= a) << group << " " << region;
+      for (const nlohmann::json* row : rows) {
+        EXPECT_EQ(marked(*row), (*pair)["better"] == (*row)["label"]) << group << " " << region;
+      }
     }
+  }
+  // Efficiency relative to the baseline (sa): exactly 1 for sa itself.
+  for (const nlohmann::json& row : table["rows"]) {
+    if (row["label"] != "sa") continue;
+    EXPECT_DOUBLE_EQ(row["efficiency"]["mean"].get<double>(), 1.0);
   }
 
   // The CSV holds the same numbers (full precision) and the refusal.
@@ -321,7 +349,7 @@ TEST_F(BatchReportTest, ChartsAndFigureExistWithTheirSizes) {
       EXPECT_NEAR(series.fit->slope, log_log_slope(series.x, series.y), 1e-9)
           << region << " " << series.name;
       EXPECT_LT(series.fit->slope, 0) << region << " " << series.name;
-      EXPECT_EQ(series.y_error.empty(), series.name != "sa");  // two repeats: error bars
+      EXPECT_FALSE(series.y_error.empty());  // three and two repeats: 95% intervals
     }
   }
   ChartSpec time_chart = mrse_time_chart(result, recomputed);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/scene/scene.h"
+#include "tests/support/peer_scenes.h"
 
 namespace penumbra {
 namespace {
@@ -97,9 +98,11 @@ std::string bracketed_after(const std::string& text, size_t from, const std::str
 }
 
 TEST(BundledScenes, CornellBoxMatchesThePbrtFileValueForValue) {
-  const std::string pbrt_path = "/work/shared/peer-scenes/cornell-box/cornell-box.pbrt";
+  const std::string pbrt_path = testing::peer_scene("cornell-box/cornell-box.pbrt");
+  if (pbrt_path.empty())
+    GTEST_SKIP() << testing::peer_scene_missing("cornell-box/cornell-box.pbrt");
   std::ifstream in(pbrt_path);
-  if (!in) GTEST_SKIP() << "peer scene not on this machine: " << pbrt_path;
+  ASSERT_TRUE(in) << pbrt_path;
   std::stringstream text;
   text << in.rdbuf();
   std::string pbrt = text.str();

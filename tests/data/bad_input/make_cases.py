@@ -194,6 +194,67 @@ scene_case("obj-no-triangles", obj_shape("meshes/no-faces.obj"),
            "OBJ file has no triangles", extra=["file: meshes/no-faces.obj = meshes/no-faces.obj"],
            why="vertices only")
 
+# pbrt-v3 scenes: every message starts with file:line:column.
+PBRT_LIGHT = ('AttributeBegin\nAreaLightSource "diffuse" "rgb L" [4 4 4]\n'
+              'Shape "quad" "point o" [0 2 0] "vector u" [1 0 0] "vector v" [0 0 1]\nAttributeEnd\n')
+
+
+def pbrt_case(name, body, message, extra=(), why="", world=True):
+    text = ("WorldBegin\n" + body + PBRT_LIGHT + "WorldEnd\n") if world else body
+    write("scenes", name + ".pbrt", text,
+          ["# " + why, "status: INVALID_ARGUMENT", "message: " + message] + list(extra))
+
+
+pbrt_case("pbrt-newline-in-string", 'Film "image\nWorldBegin\n',
+          "pbrt-newline-in-string.pbrt:1:12: newline in a string", world=False,
+          why="a string left open at the end of its line")
+pbrt_case("pbrt-unknown-statement", 'Sphere "x"\n',
+          "pbrt-unknown-statement.pbrt:2:1: unknown statement 'Sphere'", why="no such statement")
+pbrt_case("pbrt-malformed-number", "Translate 1 2 3.4.5\n",
+          "pbrt-malformed-number.pbrt:2:15: malformed number '3.4.5'", why="two decimal points")
+pbrt_case("pbrt-number-1e999", "Scale 1e999 1 1\n",
+          "pbrt-number-1e999.pbrt:2:7: number 1e999 is out of range", why="overflows a double")
+pbrt_case("pbrt-nan-word", "Translate nan 0 0\n",
+          "pbrt-nan-word.pbrt:2:11: Translate needs a number, found 'nan'",
+          why="NaN written as a word")
+pbrt_case("pbrt-index-out-of-range",
+          'Shape "trianglemesh" "point P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 5]\n',
+          'pbrt-index-out-of-range.pbrt:2:52: Shape "trianglemesh": "integer indices": index 5 '
+          'out of range [0, 3)', why="an index past the vertices")
+pbrt_case("pbrt-unterminated-array", 'Shape "trianglemesh" "point P" [0 0 0 1 0 0 0 1 0\n',
+          "pbrt-unterminated-array.pbrt:1:32: unterminated '[' (no closing ']')", world=False,
+          why="the file ends inside an array")
+pbrt_case("pbrt-ply-parent-path", 'Shape "plymesh" "string filename" "../outside/plate.ply"\n',
+          "refused PLY path: path '../outside/plate.ply' leaves the scene's folder",
+          why="a PLY path out of the scene's folder")
+pbrt_case("pbrt-ply-symlink-escape", 'Shape "plymesh" "string filename" "meshes/escape.obj"\n',
+          "outside the scene's folder",
+          extra=["wire: none", "# meshes/escape.obj is a symlink out of the folder"],
+          why="a symlink out of the folder")
+pbrt_case("pbrt-ply-missing", 'Shape "plymesh" "string filename" "meshes/nowhere.ply"\n',
+          "pbrt-ply-missing.pbrt:2:17: PLY file cannot be read",
+          why="the file is neither on disk nor in the package")
+pbrt_case("pbrt-ply-not-ply", 'Shape "plymesh" "string filename" "meshes/part.obj"\n',
+          "PLY file 'meshes/part.obj' cannot be used: not a PLY file (no 'ply' line)",
+          extra=["file: meshes/part.obj = meshes/part.obj"], why="an OBJ named as a PLY")
+pbrt_case("pbrt-texture-absolute-path",
+          'Texture "t" "spectrum" "imagemap" "string filename" "/etc/passwd"\n',
+          "refused texture path: absolute path '/etc/passwd'", why="an absolute texture path")
+pbrt_case("pbrt-point-light", 'LightSource "point" "rgb I" [1 1 1]\n',
+          'pbrt-point-light.pbrt:2:1: LightSource "point" is not modelled', why="a delta light")
+pbrt_case("pbrt-negative-radiance", 'AreaLightSource "diffuse" "rgb L" [-1 0 0]\n',
+          "radiance L must be finite and not negative", why="a negative emitter")
+pbrt_case("pbrt-no-worldend", "WorldBegin\n" + PBRT_LIGHT,
+          "the file ends before WorldEnd", world=False, why="the scene is never closed")
+pbrt_case("pbrt-no-light", "WorldBegin\nWorldEnd\n",
+          "pbrt-no-light.pbrt:2:1: the scene has no area light", world=False, why="nothing emits")
+pbrt_case("pbrt-attribute-end-unmatched", "AttributeEnd\n",
+          "pbrt-attribute-end-unmatched.pbrt:2:1: AttributeEnd without a matching AttributeBegin",
+          why="one end too many")
+pbrt_case("pbrt-shape-before-world", 'Shape "sphere"\nWorldBegin\n' + PBRT_LIGHT + "WorldEnd\n",
+          "pbrt-shape-before-world.pbrt:1:1: Shape before WorldBegin", world=False,
+          why="geometry in the options block")
+
 # Methods (submitted with a good scene).
 def method_case(name, text, message, status="INVALID_ARGUMENT", why="", extra=()):
     write("methods", name + ".txt", text,
@@ -352,6 +413,17 @@ request_case("get-scene-unknown", 'scene_hash: "' + "0" * 64 + '"\n', "NOT_FOUND
              ["rpc: /penumbra.v1.Workers/GetScene"], why="a scene never uploaded")
 request_case("get-scene-path", 'scene_hash: "../../data/penumbra.db"\n', "NOT_FOUND", "no scene",
              ["rpc: /penumbra.v1.Workers/GetScene"], why="a path as a scene hash")
+request_case("get-scene-manifest-unknown", 'scene_hash: "' + "0" * 64 + '"\n', "NOT_FOUND",
+             "no scene", ["rpc: /penumbra.v1.Workers/GetSceneManifest"],
+             why="the chunks of a scene never uploaded")
+request_case("start-upload-over-limit", 'scene_hash: "' + "0" * 64 + '" total_bytes: 1099511627776 '
+             'chunk_bytes: 1048576\n', "RESOURCE_EXHAUSTED",
+             "exceeds the coordinator's scene-size limit",
+             ["rpc: /penumbra.v1.Jobs/StartSceneUpload"], why="a 1 TiB scene announced")
+request_case("start-upload-missing-hashes", 'scene_hash: "' + "0" * 64 + '" total_bytes: 9000 '
+             'chunk_bytes: 4096 chunk_hashes: "' + "1" * 64 + '"\n', "INVALID_ARGUMENT",
+             "manifest.chunk_hashes: 1 hashes for 9000 bytes",
+             ["rpc: /penumbra.v1.Jobs/StartSceneUpload"], why="fewer chunk hashes than chunks")
 request_case("complete-task-garbage-tile", 'worker_id: "w-ghost" job_id: "job-1" attempt_token: "t" '
              'tile: "PNT1 and then nothing"\n', "INVALID_ARGUMENT", "tile: tile bytes",
              ["rpc: /penumbra.v1.Workers/CompleteTask"], why="a result tile that is not one")
