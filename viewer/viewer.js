@@ -3,7 +3,8 @@
 //
 // It reads the JSON in #viewer-data, decodes each image (RGBE planes, zlib, decoded by the
 // browser's DecompressionStream) and draws the one shown on a canvas: the method chosen by key or
-// click, or the reference ("flip"), tonemapped at the chosen exposure or as an error view. Zoom is
+// click, or the reference ("flip"), tonemapped at the chosen exposure, as an error view or as its
+// per-pixel variance (the EXR's variance layer, when the image has one). Zoom is
 // nearest neighbour down to single pixels, the view is shared by the main canvas and one crop per
 // image (synchronized crops), and hovering probes every image's value at the pixel.
 //
@@ -29,7 +30,7 @@
   var state = {
     method: methods.length ? 0 : -1,  // index into methods
     showReference: methods.length === 0,
-    view: 'image',  // 'image', 'error' (relative error), 'difference' (signed)
+    view: 'image',  // 'image', 'error' (relative error), 'difference' (signed), 'variance'
     stops: 0,       // exposure relative to data.exposure, in stops
     zoom: 1, cx: W / 2, cy: H / 2,
     split: false, splitAt: 0.5,
@@ -74,13 +75,14 @@
   // ---- decoding ----
   var SCALE = new Float64Array(256);  // 2^(stored - 128 - 8), 0 for the black marker
   for (var e = 1; e < 256; ++e) SCALE[e] = Math.pow(2, e - 136);
-  function decode(image) {
-    var text = atob(image.data), bytes = new Uint8Array(text.length);
+  // The planes of base64 text, and the linear RGB they hold.
+  function decodePlanes(base64, what) {
+    var text = atob(base64), bytes = new Uint8Array(text.length);
     for (var i = 0; i < text.length; ++i) bytes[i] = text.charCodeAt(i);
     var stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
     return new Response(stream).arrayBuffer().then(function (buffer) {
       var planes = new Uint8Array(buffer);
-      if (planes.length !== 4 * N) throw new Error(image.label + ': ' + planes.length + ' bytes, expected ' + 4 * N);
+      if (planes.length !== 4 * N) throw new Error(what + ': ' + planes.length + ' bytes, expected ' + 4 * N);
       var rgb = new Float32Array(3 * N);
       for (var p = 0; p < N; ++p) {
         var s = SCALE[planes[3 * N + p]];
@@ -89,10 +91,34 @@
         rgb[3 * p + 1] = planes[N + p] * s;
         rgb[3 * p + 2] = planes[2 * N + p] * s;
       }
-      image.planes = planes;
-      image.rgb = rgb;
-      delete image.data;
+      return {planes: planes, rgb: rgb};
     });
+  }
+  function decode(image) {
+    var pending = [decodePlanes(image.data, image.label).then(function (decoded) {
+      image.planes = decoded.planes;
+      image.rgb = decoded.rgb;
+      delete image.data;
+    })];
+    if (image.variance) {
+      pending.push(decodePlanes(image.variance, image.label + ' variance').then(function (decoded) {
+        image.varianceRgb = decoded.rgb;
+        delete image.variance;
+      }));
+    }
+    return Promise.all(pending);
+  }
+  // A pixel's relative variance: mean over channels of variance / (ref^2 + epsilon), its expected
+  // term of the MRSE from noise alone.
+  function relativeVariance(image, p) {
+    var v = image.varianceRgb, r = reference.rgb, sum = 0;
+    for (var c = 0; c < 3; ++c) sum += v[3 * p + c] / (r[3 * p + c] * r[3 * p + c] + data.mrse_epsilon);
+    return sum / 3;
+  }
+  // Position of a relative variance on the variance view's logarithmic scale.
+  var LOG_LOW = Math.log10(data.variance_scale[0]), LOG_HIGH = Math.log10(data.variance_scale[1]);
+  function varianceT(value) {
+    return value > 0 ? (Math.log10(value) - LOG_LOW) / (LOG_HIGH - LOG_LOW) : 0;
   }
 
   // ---- layers: each image in each view, at image resolution ----
@@ -123,6 +149,12 @@
         if (e === 0) { out[o] = out[o + 1] = out[o + 2] = 0; } else {
           out[o] = lut[e | planes[p]]; out[o + 1] = lut[e | planes[N + p]]; out[o + 2] = lut[e | planes[2 * N + p]];
         }
+        out[o + 3] = 255;
+      }
+    } else if (view === 'variance') {
+      for (p = 0, o = 0; p < N; ++p, o += 4) {
+        if (image.varianceRgb) viridis(varianceT(relativeVariance(image, p)), out, o);
+        else out[o] = out[o + 1] = out[o + 2] = 85;  // no variance layer: grey
         out[o + 3] = 255;
       }
     } else {
@@ -169,7 +201,8 @@
   });
   var viewGroup = bar.appendChild(el('div', {'class': 'pv-group'}));
   var viewButtons = {};
-  [['image', 'I', 'image'], ['error', 'E', 'relative error'], ['difference', 'D', 'difference']].forEach(function (v) {
+  [['image', 'I', 'image'], ['error', 'E', 'relative error'], ['difference', 'D', 'difference'],
+   ['variance', 'V', 'variance']].forEach(function (v) {
     var button = el('button', {type: 'button', 'data-view': v[0]});
     button.appendChild(el('kbd', {}, v[1]));
     button.appendChild(document.createTextNode(' ' + v[2]));
@@ -225,6 +258,7 @@
   root.appendChild(el('p', {'class': 'note pv-help'},
       'Keys: 1–9 a method, R or 0 the reference, Space flips between the method and the reference, ' +
       'I image, E relative error |x − ref| / (ref + ' + data.relative_error_offset + '), D signed difference, ' +
+      'V variance (of the mean, from the EXR\'s variance layer, relative: σ² / (ref² + ' + data.mrse_epsilon + ')), ' +
       '[ and ] exposure ∓½ stop, + and − zoom (or the wheel), arrows pan (or drag), F fit, S split ' +
       '(drag the divider), O region outlines. Hover a pixel for every image\'s value. The crops below ' +
       'show every image at the same view; click one to show it.'));
@@ -346,7 +380,7 @@
     if (!state.probe) { probeTable.appendChild(el('tr')).appendChild(el('td', {'class': 'text'}, 'Hover the image to probe a pixel.')); return; }
     var x = state.probe[0], y = state.probe[1], i = 3 * (y * W + x), r = reference.rgb, offset = data.relative_error_offset;
     var head = probeTable.appendChild(el('tr'));
-    ['pixel ' + x + ', ' + y, 'R', 'G', 'B', 'rel. error'].forEach(function (t) { head.appendChild(el('th', {}, t)); });
+    ['pixel ' + x + ', ' + y, 'R', 'G', 'B', 'rel. error', 'rel. variance'].forEach(function (t) { head.appendChild(el('th', {}, t)); });
     images.forEach(function (image, index) {
       var row = probeTable.appendChild(el('tr', {'data-index': index}));
       if (index === shownIndex()) row.className = 'pv-selected';
@@ -357,11 +391,26 @@
         sum += Math.abs(image.rgb[i + c] - r[i + c]) / (Math.abs(r[i + c]) + offset);
       }
       row.appendChild(el('td', {}, index === 0 ? '–' : fmt(sum / 3)));
+      row.appendChild(el('td', {}, image.varianceRgb ? fmt(relativeVariance(image, y * W + x)) : '–'));
     });
   }
   function scaleLegend() {
     scaleBar.textContent = '';
     if (state.view === 'image') return;
+    if (state.view === 'variance') {
+      if (!images[shownIndex()].varianceRgb) {
+        scaleBar.appendChild(el('span', {'class': 'note'}, 'This image has no variance layer.'));
+        return;
+      }
+      scaleBar.appendChild(el('span', {}, '≤ ' + fmt(data.variance_scale[0])));
+      var band = scaleBar.appendChild(el('span', {'class': 'pv-gradient'}));
+      band.style.background = 'linear-gradient(to right, #440154, #3b528b, #21918c, #5ec962, #fde725)';
+      scaleBar.appendChild(el('span', {}, '≥ ' + fmt(data.variance_scale[1])));
+      scaleBar.appendChild(el('span', {'class': 'note'},
+          ' variance of the mean / (ref² + ' + data.mrse_epsilon + '), mean over channels, log scale: ' +
+          'the pixel\'s expected MRSE term from noise'));
+      return;
+    }
     var gradient = state.view === 'error'
         ? 'linear-gradient(to right, #440154, #3b528b, #21918c, #5ec962, #fde725)'
         : 'linear-gradient(to right, rgb(33,102,172), rgb(247,247,247), rgb(178,24,43))';
@@ -412,7 +461,7 @@
     ' ': function () { if (state.method >= 0) state.showReference = !state.showReference; },
     r: function () { state.showReference = true; }, '0': function () { state.showReference = true; },
     i: function () { state.view = 'image'; }, e: function () { state.view = 'error'; },
-    d: function () { state.view = 'difference'; },
+    d: function () { state.view = 'difference'; }, v: function () { state.view = 'variance'; },
     '[': function () { state.stops = Math.max(-10, state.stops - 0.5); },
     ']': function () { state.stops = Math.min(10, state.stops + 0.5); },
     '+': function () { zoomBy(2); }, '=': function () { zoomBy(2); }, '-': function () { zoomBy(0.5); },

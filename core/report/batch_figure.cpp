@@ -201,6 +201,17 @@ Region clip_to_image(const Region& region, int width, int height) {
 
 }  // namespace
 
+double choose_error_scale(const std::vector<const Image*>& images, const Image& reference) {
+  std::vector<float> pooled;
+  for (const Image* image : images) {
+    if (!image) continue;
+    Image map = relative_error_map(*image, reference);
+    for (size_t i = 0; i < map.rgb.size(); i += 3) pooled.push_back(map.rgb[i]);
+  }
+  double high = percentile(std::move(pooled), 0.99);
+  return high > 0 ? nice_ceiling(high) : 1.0;
+}
+
 double choose_exposure(const Image& reference) {
   std::vector<float> luminances;
   luminances.reserve(size_t(reference.width) * reference.height);
@@ -264,16 +275,14 @@ BatchFigureInfo write_batch_figure(const BatchResult& result, const RecomputedEr
       throw std::runtime_error(method.runs[size_t(run)].exr + ": size differs from the reference");
   }
 
-  // One error scale for all maps: the 99th percentile of the pooled relative errors.
+  // One error scale for all maps.
   std::vector<Image> error_maps;
-  std::vector<float> pooled;
+  std::vector<const Image*> shown;
   for (const Image& image : images) {
     error_maps.push_back(image.width ? relative_error_map(image, reference) : Image());
-    for (size_t i = 0; i < error_maps.back().rgb.size(); i += 3)
-      pooled.push_back(error_maps.back().rgb[i]);
+    if (image.width) shown.push_back(&image);
   }
-  double high = percentile(std::move(pooled), 0.99);
-  info.error_scale = high > 0 ? nice_ceiling(high) : 1.0;
+  info.error_scale = choose_error_scale(shown, reference);
 
   // Geometry.
   const int column_width = std::max(64, options.figure_column_width);

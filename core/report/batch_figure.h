@@ -30,6 +30,11 @@ double choose_exposure(const Image& reference);
 // Relative error per pixel, averaged over the three channels: |x - ref| / (ref + 0.01).
 Image relative_error_map(const Image& image, const Image& reference);
 
+// The top of the relative error's colour scale shared by every image: the 99th percentile of
+// their pooled relative errors, rounded up to 1, 2 or 5 times a power of ten (1 when every error
+// is 0). Null images are skipped.
+double choose_error_scale(const std::vector<const Image*>& images, const Image& reference);
+
 // The viridis colour map at t in [0, 1] (clamped), linear interpolation between 9 samples.
 Rgb viridis(double t);
 

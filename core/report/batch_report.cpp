@@ -35,15 +35,16 @@ ComparisonViewerContent viewer_content(const BatchResult& result, const BatchTab
                                        const RecomputedErrors& recomputed,
                                        const BatchFigureInfo& figure,
                                        const std::filesystem::path& result_dir,
-                                       std::vector<Image>& images) {
+                                       std::vector<Image>& images, std::vector<Image>& variances) {
   ComparisonViewerContent content;
   images.clear();
+  variances.clear();
   images.reserve(result.methods.size() + 1);
-  images.push_back(read_exr((result_dir / result.reference.exr).string()));
+  variances.reserve(result.methods.size() + 1);
+  variances.emplace_back();
+  images.push_back(read_exr((result_dir / result.reference.exr).string(), nullptr, &variances[0]));
   content.width = images[0].width;
   content.height = images[0].height;
-  content.exposure = figure.exposure;
-  content.error_scale = figure.error_scale;
   content.reference.label = "reference";
   content.reference.method = result.reference.method;
   content.reference.sampler = result.reference.sampler;
@@ -58,10 +59,16 @@ ComparisonViewerContent viewer_content(const BatchResult& result, const BatchTab
     int run = m < figure.shown_runs.size() ? figure.shown_runs[m] : -1;
     if (run < 0) continue;
     shown.push_back({m, size_t(run)});
-    images.push_back(read_exr((result_dir / result.methods[m].runs[size_t(run)].exr).string()));
+    variances.emplace_back();
+    images.push_back(read_exr((result_dir / result.methods[m].runs[size_t(run)].exr).string(),
+                              nullptr, &variances.back()));
   }
+  // A file without a variance layer reads as a 0x0 variance: the viewer says it has none.
+  auto variance_of = [&](size_t index) -> const Image* {
+    return variances[index].width ? &variances[index] : nullptr;
+  };
   content.reference.image = &images[0];
-  std::vector<const Image*> method_images;
+  content.reference.variance = variance_of(0);
   for (size_t i = 0; i < shown.size(); ++i) {
     const BatchMethod& method = result.methods[shown[i].method];
     const BatchRun& run = method.runs[shown[i].run];
@@ -73,6 +80,7 @@ ComparisonViewerContent viewer_content(const BatchResult& result, const BatchTab
     image.repeat = run.repeat;
     image.compute_seconds = run.compute_seconds;
     image.image = &images[i + 1];
+    image.variance = variance_of(i + 1);
     for (const auto& [region, summary] : recomputed[shown[i].method][shown[i].run])
       image.mrse[region] = summary.mrse;
     for (const BatchTableRow& row : table.rows) {
@@ -83,10 +91,13 @@ ComparisonViewerContent viewer_content(const BatchResult& result, const BatchTab
       for (const auto& [region, cell] : row.cells) image.corrected[region] = cell.corrected;
       image.repeats = row.repeats;
     }
-    method_images.push_back(image.image);
     content.methods.push_back(std::move(image));
   }
-  content.difference_scale = choose_difference_scale(method_images, images[0]);
+  // The same scales as the coordinator's batch page; the exposure and error scale are the
+  // figure's (its exposure may be given on the command line).
+  choose_viewer_scales(content);
+  content.exposure = figure.exposure;
+  content.error_scale = figure.error_scale;
   return content;
 }
 
@@ -140,9 +151,9 @@ void write_batch_report(const std::filesystem::path& result_dir,
   content.figure_png = out_dir / "figure.png";
   content.figure = write_batch_figure(result, recomputed, result_dir, content.figure_png, options);
   {
-    std::vector<Image> images;
+    std::vector<Image> images, variances;
     content.viewer_html = comparison_viewer_html(
-        viewer_content(result, table, recomputed, content.figure, result_dir, images));
+        viewer_content(result, table, recomputed, content.figure, result_dir, images, variances));
   }
   write_text_file(out_dir / "report.html", batch_report_html(content));
 }

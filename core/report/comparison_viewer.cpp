@@ -9,7 +9,10 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <tuple>
 
+#include "core/image/metrics.h"
+#include "core/report/batch_figure.h"
 #include "core/report/batch_html.h"
 #include "penumbra/viewer_assets.h"
 
@@ -51,6 +54,15 @@ nlohmann::json image_json(const ViewerImage& image, int width, int height) {
                          {"repeats", image.repeats},
                          {"compute_seconds", image.compute_seconds},
                          {"data", base64_encode(encode_viewer_image(*image.image))}};
+  if (image.variance) {
+    if (image.variance->width != width || image.variance->height != height ||
+        image.variance->rgb.size() != size_t(width) * height * 3)
+      throw std::invalid_argument("comparison viewer: " + image.label + ": variance layer is " +
+                                  std::to_string(image.variance->width) + "x" +
+                                  std::to_string(image.variance->height) + ", expected " +
+                                  std::to_string(width) + "x" + std::to_string(height));
+    json["variance"] = base64_encode(encode_viewer_image(*image.variance));
+  }
   json["mrse"] = nlohmann::json::object();
   for (const auto& [region, value] : image.mrse) json["mrse"][region] = value;
   json["corrected"] = nlohmann::json::object();
@@ -127,6 +139,7 @@ Image decode_viewer_image(const std::string& bytes, int width, int height) {
 double choose_difference_scale(const std::vector<const Image*>& images, const Image& reference) {
   std::vector<float> magnitudes;
   for (const Image* image : images) {
+    if (!image) continue;
     check_same_size(*image, reference);
     for (size_t i = 0; i + 2 < reference.rgb.size(); i += 3) {
       double difference = 0;
@@ -141,12 +154,59 @@ double choose_difference_scale(const std::vector<const Image*>& images, const Im
   return magnitudes[index] > 0 ? double(magnitudes[index]) : 1.0;
 }
 
+std::pair<double, double> choose_variance_scale(const std::vector<const Image*>& variances,
+                                                const Image& reference) {
+  std::vector<float> relative;
+  for (const Image* variance : variances) {
+    if (!variance) continue;
+    check_same_size(*variance, reference);
+    for (size_t i = 0; i + 2 < reference.rgb.size(); i += 3) {
+      double sum = 0;
+      for (size_t c = 0; c < 3; ++c) {
+        double r = reference.rgb[i + c];
+        sum += double(variance->rgb[i + c]) / (r * r + kMrseEpsilon);
+      }
+      if (std::isfinite(sum) && sum > 0) relative.push_back(float(sum / 3));
+    }
+  }
+  if (relative.empty()) return {1e-6, 1};
+  auto at = [&](double fraction) {
+    size_t index = std::min(relative.size() - 1, size_t(fraction * double(relative.size())));
+    std::nth_element(relative.begin(), relative.begin() + ptrdiff_t(index), relative.end());
+    return double(relative[index]);
+  };
+  double low = std::pow(10.0, std::floor(std::log10(at(0.01))));
+  double high = std::pow(10.0, std::ceil(std::log10(at(0.99))));
+  if (!(high > low)) high = low * 10;
+  return {low, high};
+}
+
+void choose_viewer_scales(ComparisonViewerContent& content) {
+  if (!content.reference.image)
+    throw std::invalid_argument("comparison viewer: reference: no image");
+  const Image& reference = *content.reference.image;
+  std::vector<const Image*> images, variances;
+  for (const ViewerImage& method : content.methods) {
+    images.push_back(method.image);
+    variances.push_back(method.variance);
+  }
+  content.exposure = choose_exposure(reference);
+  content.error_scale = choose_error_scale(images, reference);
+  content.difference_scale = choose_difference_scale(images, reference);
+  std::tie(content.variance_low, content.variance_high) =
+      choose_variance_scale(variances, reference);
+}
+
 std::string comparison_viewer_html(const ComparisonViewerContent& content) {
-  nlohmann::json data = {
-      {"encoding", kViewerImageEncoding},   {"width", content.width},
-      {"height", content.height},           {"exposure", content.exposure},
-      {"error_scale", content.error_scale}, {"difference_scale", content.difference_scale},
-      {"relative_error_offset", 0.01}};
+  nlohmann::json data = {{"encoding", kViewerImageEncoding},
+                         {"width", content.width},
+                         {"height", content.height},
+                         {"exposure", content.exposure},
+                         {"error_scale", content.error_scale},
+                         {"difference_scale", content.difference_scale},
+                         {"relative_error_offset", kRelativeErrorOffset},
+                         {"mrse_epsilon", kMrseEpsilon},
+                         {"variance_scale", {content.variance_low, content.variance_high}}};
   data["regions"] = nlohmann::json::array();
   for (const ViewerRegion& region : content.regions)
     data["regions"].push_back(

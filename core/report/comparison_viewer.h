@@ -3,8 +3,9 @@
 // at full resolution in one HTML section (data, style and script inlined, no network), flipped by
 // key or click, zoomed to single pixels (nearest neighbour) and panned in step across all
 // methods, tonemapped in the page (exposure in stops, sRGB), with false-colour error views, the
-// regions outlined and each method's MRSE with its 95% interval beside it. The script and style
-// are viewer/viewer.js and viewer/viewer.css, embedded at build time.
+// regions outlined and each method's MRSE with its 95% interval beside it, and a view of each
+// image's per-pixel variance (its EXR's variance layer). The script and style are
+// viewer/viewer.js and viewer/viewer.css, embedded at build time.
 //
 // Pixel data: "rgbe8-planar-deflate". Each pixel's linear RGB is stored as three 8-bit mantissas
 // sharing one 8-bit exponent (Ward's RGBE, as in Radiance .hdr files, rounded to nearest): with e
@@ -16,7 +17,8 @@
 // compression instead of 6 for half floats or 12 for floats. The four planes (all R mantissas,
 // then G, B, exponents; rows top to bottom) are compressed with zlib and decoded in the page by
 // the browser's DecompressionStream("deflate"). Negative, NaN and infinite channels are stored as
-// 0; a pixel whose brightest channel is below 2^-120 as black.
+// 0; a pixel whose brightest channel is below 2^-120 as black. An image's variance layer
+// (variance of the mean per channel) is encoded the same way.
 
 #include <map>
 #include <string>
@@ -53,6 +55,9 @@ struct ViewerImage {
   // there is no such row (the reference, or a report without the comparison).
   std::map<std::string, MeanInterval> corrected;
   int repeats = 0;  // in the row
+  // The variance of the mean per pixel and channel (the EXR's variance layer), or null when the
+  // image has none: the variance view then says so.
+  const Image* variance = nullptr;
 };
 
 struct ViewerRegion {
@@ -65,6 +70,10 @@ struct ComparisonViewerContent {
   double exposure = 1;          // the base exposure (the figure's), scale on linear values
   double error_scale = 1;       // top of the relative error's colour scale (the figure's)
   double difference_scale = 1;  // the signed difference's colour scale is [-this, this]
+  // The variance view's logarithmic colour scale, [variance_low, variance_high], on the relative
+  // variance: mean over channels of variance / (ref^2 + kMrseEpsilon), a pixel's expected term of
+  // the MRSE from noise alone.
+  double variance_low = 1e-6, variance_high = 1;
   ViewerImage reference;
   std::vector<ViewerImage> methods;  // in batch order, refused methods left out
   std::vector<ViewerRegion> regions;
@@ -73,6 +82,17 @@ struct ComparisonViewerContent {
 // The 99th percentile over every method's pixels of |mean over channels of (x - ref)|: the
 // signed difference's colour scale (1 when every difference is 0).
 double choose_difference_scale(const std::vector<const Image*>& images, const Image& reference);
+
+// The variance view's scale: the decades around the 1st and 99th percentiles of every method's
+// positive relative variance (see ComparisonViewerContent); [1e-6, 1] when no method has a
+// variance layer.
+std::pair<double, double> choose_variance_scale(const std::vector<const Image*>& variances,
+                                                const Image& reference);
+
+// Every scale of the content from its images, as the report's figure chooses them: the
+// exposure (choose_exposure of the reference), the relative error's (choose_error_scale), the
+// signed difference's and the variance view's.
+void choose_viewer_scales(ComparisonViewerContent& content);
 
 // The viewer's section of the page (a <section id="viewer"> with its <style>, the data as a
 // <script type="application/json"> and the viewer's <script>). Throws std::invalid_argument when

@@ -272,6 +272,7 @@ struct SyntheticBatch {
   fs::path dir;
   Image reference;
   std::vector<Image> methods;
+  std::vector<Image> variances;  // the methods' variance layers
   std::vector<std::string> labels = {"low-noise", "high-noise"};
   Region region{10, 8, 30, 24};
 };
@@ -296,8 +297,18 @@ SyntheticBatch write_synthetic_batch(const fs::path& dir) {
     std::normal_distribution<double> noise(0, m == 0 ? 0.05 : 0.3);
     Image image = batch.reference;
     for (float& v : image.rgb) v = float(std::max(0.0, v * (1 + noise(random))));
+    // The variance of the mean the noise would have at 16 spp, rising to the right: its view
+    // shows a gradient across two decades.
+    Image variance(kWidth, kHeight);
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x) {
+        Rgb ref = batch.reference.at(x, y);
+        double relative = noise.stddev() * noise.stddev() / 16 * std::pow(10.0, 2.0 * x / kWidth);
+        variance.set(x, y, Rgb{ref.x * ref.x, ref.y * ref.y, ref.z * ref.z} * relative);
+      }
     std::string exr = "runs/" + batch.labels[m] + ".r0.exr";
-    write_exr((dir / exr).string(), image, nullptr, {});
+    write_exr((dir / exr).string(), image, &variance, {});
+    batch.variances.push_back(std::move(variance));
     json errors = json::array();
     for (const auto& [region, summary] :
          error_summary(image, batch.reference, {{"middle", batch.region}}))
@@ -476,6 +487,37 @@ TEST(ViewerBrowser, FlipZoomExposureErrorViewsProbeAndLinks) {
       expected[c] = int(std::lround(247 * (1 - std::abs(t)) + end[c] * std::abs(t)));
     expect_near(page.pixel(384, 288), expected, 1, "signed difference");
   }
+  // The variance view: viridis of the relative variance mean(var / (ref^2 + 1e-6)) on the
+  // logarithmic scale chosen from every method's variance layer.
+  {
+    page.key("v", "KeyV", 86);
+    EXPECT_EQ(page.attribute("data-view"), "variance");
+    const auto [low, high] =
+        choose_variance_scale({&batch.variances[0], &batch.variances[1]}, batch.reference);
+    EXPECT_DOUBLE_EQ(scale["variance_scale"][0].get<double>(), low);
+    EXPECT_DOUBLE_EQ(scale["variance_scale"][1].get<double>(), high);
+    EXPECT_LT(low, high);
+    const Image quantized_variance =
+        decode_viewer_image(encode_viewer_image(batch.variances[1]), kWidth, kHeight);
+    // The canvas centre shows image pixel (32, 24); the canvas pixel up-left of it (31, 23).
+    for (const auto& [canvas_x, canvas_y, x, y] :
+         {std::array<int, 4>{384, 288, 32, 24}, std::array<int, 4>{383, 287, 31, 23}}) {
+      double relative = 0;
+      for (int c = 0; c < 3; ++c) {
+        double r = quantized_reference.at(x, y)[c];
+        relative += quantized_variance.at(x, y)[c] / (r * r + kMrseEpsilon);
+      }
+      relative /= 3;
+      Rgb colour =
+          viridis((std::log10(relative) - std::log10(low)) / (std::log10(high) - std::log10(low)));
+      expect_near(page.pixel(canvas_x, canvas_y),
+                  {int(std::lround(255 * colour.x)), int(std::lround(255 * colour.y)),
+                   int(std::lround(255 * colour.z))},
+                  1, "relative variance at " + std::to_string(x) + ", " + std::to_string(y));
+    }
+    json legend = page.eval("document.querySelector('#viewer .pv-scale').textContent");
+    EXPECT_NE(legend.get<std::string>().find("log scale"), std::string::npos) << legend;
+  }
   page.key("i", "KeyI", 73);
   EXPECT_EQ(page.attribute("data-view"), "image");
 
@@ -519,6 +561,10 @@ TEST(ViewerBrowser, FlipZoomExposureErrorViewsProbeAndLinks) {
     }
   }
   EXPECT_EQ(requests, 1);
+  // Attached to the test's output: GoogleTest's XML report (--gtest_output=xml) lists them as
+  // properties, ctest's as ATTACHED_FILES (tests/CMakeLists.txt), and the log names them.
+  RecordProperty("screenshot_fit", (dir / "viewer-fit.png").string());
+  RecordProperty("screenshot_zoom48", (dir / "viewer-zoom48.png").string());
   std::printf("viewer screenshots: %s, %s (%.1f s)\n", (dir / "viewer-fit.png").c_str(),
               (dir / "viewer-zoom48.png").c_str(),
               std::chrono::duration<double>(Clock::now() - start).count());
