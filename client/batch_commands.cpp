@@ -71,16 +71,25 @@ std::string progress_line(const v1::BatchStatus& status) {
   return text;
 }
 
-// Follows the batch: a bar of jobs done with their rate and the ETA, redrawn in place on a
-// terminal; plain lines (at most one per 2 s, and one per phase) otherwise.
-v1::BatchStatus watch_batch(farm::BatchClient& client, const std::string& batch_id) {
-  ProgressReporter progress(batch_id, ProgressMode::Auto, stdout);
+// Follows the batch: a bar of jobs done with their rate and the ETA and the running jobs' MRSE,
+// redrawn in place on a terminal; plain lines (at most one per 2 s, and one per phase)
+// otherwise; nothing with `quiet`.
+v1::BatchStatus watch_batch(farm::BatchClient& client, const std::string& batch_id,
+                            bool quiet = false) {
+  ProgressReporter progress(batch_id, quiet ? ProgressMode::Quiet : ProgressMode::Auto, stdout);
   std::string phase;
   v1::BatchStatus final_status = client.watch(batch_id, [&](const v1::BatchStatus& status) {
-    char extra[160];
-    std::snprintf(extra, sizeof extra, "%s, compute %.1f s, wall %.1f s",
+    char text[160];
+    std::snprintf(text, sizeof text, "%s, compute %.1f s, wall %.1f s",
                   state_name(status.state()).c_str(), status.compute_seconds(),
                   status.wall_seconds());
+    std::string extra = text;
+    std::vector<std::pair<std::string, double>> running;
+    for (const v1::BatchMethodStatus& method : status.methods())
+      for (const v1::BatchRun& run : method.runs())
+        if (run.job().state() == v1::JOB_STATE_RUNNING && run.job().has_mrse())
+          running.emplace_back(method.label(), run.job().mrse());
+    if (!running.empty()) extra += ", " + running_mrse_text(running);
     if (state_name(status.state()) != phase) {
       if (!phase.empty()) progress.note(batch_id + ": " + state_name(status.state()));
       phase = state_name(status.state());
@@ -206,12 +215,14 @@ struct SpecArguments {
   bool coordinator_given = false;
   int workers = 0;
   bool no_report = false;
+  bool quiet = false;
 };
 
 struct IdArguments {
   std::string id;
   std::string output;
   ConnectionArguments connection;
+  bool quiet = false;  // watch: no progress
 };
 
 }  // namespace
@@ -249,7 +260,7 @@ std::string run_batch(const std::string& spec_text, const std::string& source_na
   std::printf("%s submitted (scene %s)\n", response.batch_id().c_str(),
               response.scene_hash().substr(0, 12).c_str());
   std::fflush(stdout);
-  v1::BatchStatus status = watch_batch(client, response.batch_id());
+  v1::BatchStatus status = watch_batch(client, response.batch_id(), settings.quiet);
   if (status.state() != v1::BATCH_STATE_DONE)
     throw std::runtime_error(response.batch_id() + " ended " + state_name(status.state()) +
                              (status.error().empty() ? std::string() : ": " + status.error()));
@@ -279,6 +290,8 @@ void add_batch_commands(CLI::App& app) {
   run->add_option("--workers", run_arguments->workers,
                   "Without --coordinator: local workers of the embedded farm (0: one per core)");
   run->add_flag("--no-report", run_arguments->no_report, "Write the result folder only");
+  run->add_flag("--quiet,-q", run_arguments->quiet,
+                "No progress (a bar on a terminal, else lines)");
   run->callback([run, run_arguments] {
     std::string path = run_arguments->spec;
     if (!std::filesystem::exists(path) && path.find('/') == std::string::npos)
@@ -294,6 +307,7 @@ void add_batch_commands(CLI::App& app) {
     }
     settings.workers = run_arguments->workers;
     settings.write_report = !run_arguments->no_report;
+    settings.quiet = run_arguments->quiet;
     run_batch(read_file(path), path, folder_of(path), run_arguments->output, settings);
   });
 
@@ -320,9 +334,12 @@ void add_batch_commands(CLI::App& app) {
     return command;
   };
   auto watch_arguments = std::make_shared<IdArguments>();
-  id_command("watch", "Follow a batch until it ends", watch_arguments)->callback([watch_arguments] {
+  CLI::App* watch = id_command("watch", "Follow a batch until it ends", watch_arguments);
+  watch->add_flag("--quiet,-q", watch_arguments->quiet,
+                  "No progress (a bar on a terminal, else lines)");
+  watch->callback([watch_arguments] {
     farm::BatchClient client(connection_of(watch_arguments->connection));
-    v1::BatchStatus status = watch_batch(client, watch_arguments->id);
+    v1::BatchStatus status = watch_batch(client, watch_arguments->id, watch_arguments->quiet);
     print_status(status);
     if (status.state() != v1::BATCH_STATE_DONE) set_command_exit_code(1);
   });

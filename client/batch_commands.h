@@ -19,6 +19,7 @@ struct BatchRunSettings {
   int threads_per_worker = 1;                    // embedded farm
   bool print_table = true;                       // the summary table on stdout
   bool write_report = true;                      // write_batch_report into the output folder
+  bool quiet = false;                            // no progress while the batch runs
 };
 
 // Submits the spec (text, with `source_name` and `base_dir` for its relative paths), watches it

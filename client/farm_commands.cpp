@@ -19,6 +19,7 @@
 #include "client/cli_options.h"
 #include "client/commands.h"
 #include "client/connection_options.h"
+#include "client/progress.h"
 #include "client/read_file.h"
 #include "client/scene_checks.h"
 #include "core/scene/render_settings.h"
@@ -46,76 +47,34 @@ std::string budget_text(const v1::JobStatus& status) {
   return text;
 }
 
-// Fraction done: passes for an spp budget, compute seconds for a seconds budget.
-double fraction_done(const v1::JobStatus& status) {
-  if (status.state() == v1::JOB_STATE_DONE) return 1.0;
-  if (status.spp_budget() && status.tasks_total())
-    return double(status.tasks_complete()) / double(status.tasks_total());
-  // A spent seconds budget still waits for the tasks in flight: short of 100% until done.
-  if (status.seconds_budget() > 0)
-    return std::min(0.99, status.compute_seconds() / status.seconds_budget());
-  return 0.0;
-}
-
-std::string progress_line(const v1::JobStatus& status) {
-  double fraction = fraction_done(status);
-  constexpr int kBarWidth = 24;
-  int filled = int(std::lround(fraction * kBarWidth));
-  std::string bar =
-      "[" + std::string(size_t(filled), '#') + std::string(size_t(kBarWidth - filled), '-') + "]";
-  char text[256];
-  std::string eta = "--";
-  if (fraction > 0.01 && fraction < 1.0 && status.wall_seconds() > 0) {
-    char eta_text[32];
-    std::snprintf(eta_text, sizeof eta_text, "%.0f s",
-                  status.wall_seconds() * (1.0 - fraction) / fraction);
-    eta = eta_text;
-  } else if (fraction >= 1.0) {
-    eta = "0 s";
-  }
-  std::snprintf(text, sizeof text,
-                "%s %s %3.0f%%  %u spp  tiles %u/%u  compute %.1f s  wall %.1f s  ETA %s",
-                status.job_id().c_str(), bar.c_str(), fraction * 100, status.passes_complete(),
-                status.tiles_complete(), status.tiles_total(), status.compute_seconds(),
-                status.wall_seconds(), eta.c_str());
-  std::string line = text;
-  if (status.wall_seconds() > 0) {
-    // Samples per pixel per wall second so far: the job's rate.
-    std::snprintf(text, sizeof text, "  %.3g spp/s",
-                  status.passes_complete() / status.wall_seconds());
-    line += text;
-  }
-  if (status.tasks_leased() > 0)
-    line += "  leased " + std::to_string(status.tasks_leased());  // rendering, not yet complete
-  if (status.has_mrse()) {
-    std::snprintf(text, sizeof text, "  MRSE %.4g", status.mrse());
-    line += text;
-  }
-  return line + "  " + state_name(status.state());
-}
-
-// Follows a job until it ends: a live bar on a terminal, a line per second otherwise.
-// Returns the final status; sets a failing exit code when the job did not finish.
-v1::JobStatus watch_job(FarmClient& client, const std::string& job_id) {
-  const bool terminal = isatty(STDOUT_FILENO);
-  auto last_print = std::chrono::steady_clock::now() - std::chrono::hours(1);
-  std::string last_line;
-  v1::JobStatus last = client.watch(job_id, [&](const v1::JobStatus& status) {
-    auto now = std::chrono::steady_clock::now();
-    if (terminal) {
-      std::printf("\r\033[K%s", progress_line(status).c_str());
-      std::fflush(stdout);
-    } else if (now - last_print >= std::chrono::seconds(1)) {
-      last_line = progress_line(status);
-      std::printf("%s\n", last_line.c_str());
-      std::fflush(stdout);
-      last_print = now;
-    }
-  });
-  if (terminal)
-    std::printf("\r\033[K%s\n", progress_line(last).c_str());
-  else if (progress_line(last) != last_line)
-    std::printf("%s\n", progress_line(last).c_str());
+// Follows a job until it ends: a bar redrawn in place on a terminal, plain lines (at most one a
+// second, and the last) otherwise, nothing with `quiet`. Returns the final status; sets a
+// failing exit code when the job did not finish.
+v1::JobStatus watch_job(FarmClient& client, const std::string& job_id, bool quiet) {
+  ProgressReporter progress(job_id, quiet ? ProgressMode::Quiet : ProgressMode::Auto, stdout, 1.0);
+  auto show = [&](const v1::JobStatus& status) {
+    JobProgress job;
+    job.job_id = status.job_id();
+    job.state = state_name(status.state());
+    job.done = status.state() == v1::JOB_STATE_DONE;
+    job.spp_budget = status.spp_budget();
+    job.seconds_budget = status.seconds_budget();
+    job.passes_complete = status.passes_complete();
+    job.tiles_complete = status.tiles_complete();
+    job.tiles_total = status.tiles_total();
+    job.tasks_complete = status.tasks_complete();
+    job.tasks_total = status.tasks_total();
+    job.tasks_leased = status.tasks_leased();
+    job.compute_seconds = status.compute_seconds();
+    job.wall_seconds = status.wall_seconds();
+    if (status.has_mrse()) job.mrse = status.mrse();
+    ProgressState state = job_progress_state(job);
+    progress.update(state.done, state.total, state.unit, state.extra, state.rate, state.rate_unit,
+                    state.elapsed);
+  };
+  v1::JobStatus last = client.watch(job_id, show);
+  show(last);
+  progress.finish();
   if (last.state() != v1::JOB_STATE_DONE) {
     std::fprintf(stderr, "penumbra: %s %s%s%s\n", job_id.c_str(), state_name(last.state()).c_str(),
                  last.error().empty() ? "" : ": ", last.error().c_str());
@@ -135,6 +94,7 @@ struct SubmitArguments {
   uint64_t seed = 0;
   uint32_t tile_size = 0, passes_per_task = 0;
   bool wait = false, strict = false, accept_reference_mismatch = false;
+  bool quiet = false;  // no progress while waiting
 };
 
 void submit(const SubmitArguments& arguments) {
@@ -192,7 +152,7 @@ void submit(const SubmitArguments& arguments) {
   std::printf("%s submitted (scene %s)\n", response.job_id().c_str(),
               response.scene_hash().substr(0, 12).c_str());
   std::fflush(stdout);
-  if (arguments.wait) watch_job(client, response.job_id());
+  if (arguments.wait) watch_job(client, response.job_id(), arguments.quiet);
 }
 
 void print_status(const v1::JobStatus& status) {
@@ -276,6 +236,8 @@ void add_farm_commands(CLI::App& app) {
                              "Passes in one task (8)");
   submit_command->add_option("--name", submit_arguments->name, "A label for the job");
   submit_command->add_flag("--wait", submit_arguments->wait, "Watch the job until it ends");
+  submit_command->add_flag("--quiet,-q", submit_arguments->quiet,
+                           "With --wait: no progress (a bar on a terminal, else lines)");
   add_connection_options(submit_command, submit_arguments->connection);
   submit_command->callback([submit_arguments] { submit(*submit_arguments); });
 
@@ -283,6 +245,7 @@ void add_farm_commands(CLI::App& app) {
     ConnectionArguments connection;
     std::string job;
     std::string output;
+    bool quiet = false;  // watch: no progress
   };
   auto job_command = [&app](const std::string& name, const std::string& description,
                             std::shared_ptr<JobArguments> arguments) {
@@ -293,11 +256,14 @@ void add_farm_commands(CLI::App& app) {
   };
 
   auto watch_arguments = std::make_shared<JobArguments>();
-  job_command("watch", "Follow a job's progress: spp, tiles, ETA, current MRSE", watch_arguments)
-      ->callback([watch_arguments] {
-        FarmClient client = connect(watch_arguments->connection);
-        watch_job(client, watch_arguments->job);
-      });
+  CLI::App* watch = job_command("watch", "Follow a job's progress: spp, tiles, ETA, current MRSE",
+                                watch_arguments);
+  watch->add_flag("--quiet,-q", watch_arguments->quiet,
+                  "No progress (a bar on a terminal, else lines); the exit code says how it ended");
+  watch->callback([watch_arguments] {
+    FarmClient client = connect(watch_arguments->connection);
+    watch_job(client, watch_arguments->job, watch_arguments->quiet);
+  });
 
   auto status_arguments = std::make_shared<JobArguments>();
   job_command("status", "Show a job: state, progress, MRSE curve, errors", status_arguments)

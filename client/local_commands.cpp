@@ -20,6 +20,7 @@
 #include "core/image/metrics.h"
 #include "core/render/local_render.h"
 #include "core/render/probe.h"
+#include "core/render/sums_file.h"
 #include "core/scene/render_settings.h"
 #include "core/scene/scene.h"
 
@@ -49,10 +50,19 @@ std::string png_path_for(const std::string& exr_path) {
   return p.string();
 }
 
+// The sums file beside an EXR: FILE.sums.
+std::string sums_path_for(const std::string& exr_path) {
+  std::filesystem::path p(exr_path);
+  p.replace_extension(".sums");
+  return p.string();
+}
+
 struct RenderArgs {
   // Method, sampler and budget left empty/zero take the scene file's own, then Penumbra's
   // defaults (core/scene/render_settings.h).
   std::string scene, method, sampler, output = "out.exr", reference;
+  std::string sums;         // the exact sums' file (core/render/sums_file.h), or empty
+  uint32_t first_pass = 0;  // the first pass drawn: the rest of an interrupted render
   uint32_t spp = 0;
   double seconds = 0;
   uint64_t seed = 0;
@@ -110,6 +120,7 @@ void run_render(const RenderArgs& args) {
                              std::filesystem::path(args.output).replace_extension(".exr").string() +
                              " to get both");
   check_output_path(args.output, {".exr"}, "-o");
+  if (!args.sums.empty()) check_output_path(args.sums, {".sums"}, "--sums");
   auto scene = std::make_shared<const Scene>(load_scene(args.scene));
   report_scene_warnings(*scene, args.strict, args.scene);
   std::optional<CheckedReference> reference;
@@ -133,18 +144,30 @@ void run_render(const RenderArgs& args) {
   } else {
     budget.spp = settings.spp;
   }
+  budget.first_pass = args.first_pass;
   ProgressReporter progress("render " + scene->name,
                             args.quiet ? ProgressMode::Quiet : ProgressMode::Auto);
   const double pixels = double(scene->camera.width) * scene->camera.height;
+  // With a reference, the MRSE of the image so far after every pass block (its whole passes).
+  std::string running_mrse;
+  std::function<void(std::span<const TileAccumulator>)> measure;
+  if (reference && !progress.quiet())
+    measure = [&](std::span<const TileAccumulator> tiles) {
+      Film film = assemble_film(scene->camera.width, scene->camera.height, tiles);
+      char text[48];
+      std::snprintf(text, sizeof text, ", MRSE %.4g", mrse(film.color, reference->image));
+      running_mrse = text;
+    };
   auto report = [&](uint32_t passes, double compute_seconds) {
     const double wall = progress.elapsed();
     const double spp_rate = wall > 0 ? passes / wall : 0;
-    char samples[64];
-    std::snprintf(samples, sizeof samples, "%.3g Msamples/s", spp_rate * pixels * 1e-6);
+    char samples[96];
+    std::snprintf(samples, sizeof samples, "%.3g Msamples/s%s", spp_rate * pixels * 1e-6,
+                  running_mrse.c_str());
     if (budget.spp > 0) {
       progress.update(passes, budget.spp, "spp", samples, spp_rate, "spp/s");
     } else {
-      char extra[96];
+      char extra[160];
       std::snprintf(extra, sizeof extra, "%u spp, %s", passes, samples);
       progress.update(compute_seconds, budget.seconds, "s compute", extra,
                       wall > 0 ? compute_seconds / wall : 0.0, "compute s/s");
@@ -153,7 +176,7 @@ void run_render(const RenderArgs& args) {
   // Until the image is written, a first Ctrl-C stops the render and a second one aborts.
   InterruptScope interrupt_scope;
   LocalRenderResult result =
-      render_local(renderer, budget, args.threads, args.tile, report, &stop_render);
+      render_local(renderer, budget, args.threads, args.tile, report, &stop_render, measure);
   progress.finish();
   if (result.stopped && result.spp == 0)
     throw std::runtime_error("render interrupted before its first pass: nothing written");
@@ -163,6 +186,7 @@ void run_render(const RenderArgs& args) {
     exit_code = 3;
   }
   ImageMetadata metadata = render_metadata(*scene, options, result.spp, result.compute_seconds);
+  if (args.first_pass > 0) metadata["penumbra:first_pass"] = std::to_string(args.first_pass);
   if (result.stopped)
     metadata["penumbra:interrupted"] =
         "after " + std::to_string(result.spp) + " whole passes" +
@@ -172,6 +196,21 @@ void run_render(const RenderArgs& args) {
       metadata["penumbra:warnings"] += warning + "\n";
   write_exr(args.output, result.film.color, &result.film.variance, metadata);
   write_png_preview(png_path_for(args.output), result.film.color);
+  // The exact sums, asked for or of an interrupted render (whose remaining passes merge with it).
+  const std::string sums_path = !args.sums.empty() ? args.sums
+                                : result.stopped   ? sums_path_for(args.output)
+                                                   : "";
+  if (!sums_path.empty()) {
+    RenderSums sums;
+    sums.width = scene->camera.width;
+    sums.height = scene->camera.height;
+    sums.first_pass = args.first_pass;
+    sums.passes = result.spp;
+    sums.compute_seconds = result.compute_seconds;
+    sums.metadata = metadata;
+    sums.sums = whole_image_sums(sums.width, sums.height, result.tiles);
+    write_sums(sums_path, sums);
+  }
   std::printf("%s: %s, %s, %u spp, %.3f s compute, %.3f s wall -> %s (preview %s)\n",
               scene->name.c_str(), settings.method.c_str(), settings.sampler.c_str(), result.spp,
               result.compute_seconds, result.wall_seconds, args.output.c_str(),
@@ -179,9 +218,53 @@ void run_render(const RenderArgs& args) {
   if (result.stopped) {
     std::printf("render interrupted: the partial image has %u spp (whole passes, unbiased)\n",
                 result.spp);
+    const uint32_t next = args.first_pass + result.spp;
+    std::string rest = budget.spp > 0 ? " --spp " + std::to_string(budget.spp - result.spp) : "";
+    std::printf(
+        "its exact sums are in %s: render the remaining passes with --first-pass %u%s --sums "
+        "REST.sums, then `penumbra merge %s REST.sums -o FULL.exr` gives the image of the whole "
+        "render, bit for bit\n",
+        sums_path.c_str(), next, rest.c_str(), sums_path.c_str());
     exit_code = 130;
   }
   if (reference) print_errors(error_summary(result.film.color, reference->image, scene->regions));
+}
+
+// `penumbra merge`: the sums of disjoint pass ranges added (core/render/sums_file.h), written as
+// the EXR (and PNG preview) one render of all those passes writes.
+void run_merge(const std::vector<std::string>& inputs, const std::string& output,
+               const std::string& sums_output) {
+  check_output_path(output, {".exr"}, "-o");
+  if (!sums_output.empty()) check_output_path(sums_output, {".sums"}, "--sums");
+  std::vector<RenderSums> parts;
+  std::vector<std::string> names;
+  for (const std::string& input : inputs) {
+    std::string path = input;
+    const std::string extension = std::filesystem::path(input).extension().string();
+    if (extension == ".exr" || extension == ".EXR") {
+      path = sums_path_for(input);
+      if (!std::filesystem::exists(path))
+        throw std::runtime_error(input + ": no sums beside it (" + path +
+                                 "); an EXR holds means, which do not merge exactly: render with "
+                                 "--sums FILE.sums");
+    }
+    parts.push_back(read_sums(path));
+    names.push_back(path);
+  }
+  RenderSums merged = merge_sums(parts, names);
+  Film film = sums_film(merged);
+  if (film.nonfinite_samples > 0) {
+    std::fprintf(stderr, "penumbra: error: %llu non-finite samples (counted as zero)\n",
+                 (unsigned long long)film.nonfinite_samples);
+    exit_code = 3;
+  }
+  write_exr(output, film.color, &film.variance, merged.metadata);
+  write_png_preview(png_path_for(output), film.color);
+  if (!sums_output.empty()) write_sums(sums_output, merged);
+  std::printf("merged %zu part(s): passes %u..%llu (%u spp), %.3f s compute -> %s (preview %s)\n",
+              parts.size(), merged.first_pass,
+              (unsigned long long)(uint64_t(merged.first_pass) + merged.passes), merged.passes,
+              merged.compute_seconds, output.c_str(), png_path_for(output).c_str());
 }
 
 std::vector<int> parse_counts(const std::string& text) {
@@ -247,7 +330,32 @@ void add_local_commands(CLI::App& app) {
   render->add_flag("--strict", args->strict,
                    "Refuse the scene when its reader warns (unknown keys, ignored parameters)");
   render->add_flag("--quiet,-q", args->quiet, "No progress (a bar on a terminal, else lines)");
+  render
+      ->add_option("--first-pass", args->first_pass,
+                   "Index of the first pass drawn (default 0): the remaining passes of an "
+                   "interrupted render, to merge with its sums")
+      ->check(CLI::Range(0u, 1u << 30));
+  render->add_option("--sums", args->sums,
+                     "Also write the exact per-pixel sums (FILE.sums) for `penumbra merge`; an "
+                     "interrupted render writes them beside its EXR");
   render->callback([args] { run_render(*args); });
+
+  // merge
+  struct MergeArgs {
+    std::vector<std::string> inputs;
+    std::string output, sums;
+  };
+  auto margs = std::make_shared<MergeArgs>();
+  CLI::App* merge = app.add_subcommand(
+      "merge", "Merge renders of disjoint passes of one render (their sums) into one EXR");
+  merge
+      ->add_option("inputs", margs->inputs,
+                   "Sums files (FILE.sums), or EXRs with their sums beside them")
+      ->required();
+  merge->add_option("-o,--output", margs->output, "Output EXR; its PNG preview goes beside it")
+      ->required();
+  merge->add_option("--sums", margs->sums, "Also write the merged sums (FILE.sums)");
+  merge->callback([margs] { run_merge(margs->inputs, margs->output, margs->sums); });
 
   // probe
   struct ProbeArgs {

@@ -94,6 +94,50 @@ std::string format_progress(const ProgressState& state, bool tty, int columns, i
   return line;
 }
 
+ProgressState job_progress_state(const JobProgress& job) {
+  ProgressState state;
+  state.label = job.job_id;
+  state.elapsed = job.wall_seconds;
+  const double wall = job.wall_seconds;
+  if (job.spp_budget > 0) {
+    state.done = double(job.tasks_complete);
+    state.total = double(job.tasks_total);
+    state.unit = "tasks";
+  } else {
+    state.done =
+        job.done ? job.seconds_budget : std::min(job.compute_seconds, 0.99 * job.seconds_budget);
+    state.total = job.seconds_budget;
+    state.unit = "compute s";
+  }
+  if (job.done) state.done = state.total;
+  state.rate = wall > 0 ? state.done / wall : 0;
+  state.rate_unit = job.spp_budget > 0 ? "tasks/s" : "compute s/s";
+  std::string extra = std::to_string(job.passes_complete) + " spp";
+  if (wall > 0) extra += ", " + number(job.passes_complete / wall) + " spp/s";
+  extra += ", tiles " + std::to_string(job.tiles_complete) + "/" + std::to_string(job.tiles_total);
+  if (job.tasks_leased > 0) extra += ", leased " + std::to_string(job.tasks_leased);
+  if (job.mrse) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", *job.mrse);
+    extra += std::string(", MRSE ") + text;
+  }
+  state.extra = extra + ", " + job.state;
+  return state;
+}
+
+std::string running_mrse_text(const std::vector<std::pair<std::string, double>>& running,
+                              size_t shown) {
+  if (running.empty()) return "";
+  std::string text = "MRSE";
+  for (size_t i = 0; i < running.size() && i < shown; ++i) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%.4g", running[i].second);
+    text += (i ? ", " : " ") + running[i].first + " " + value;
+  }
+  if (running.size() > shown) text += " (+" + std::to_string(running.size() - shown) + " more)";
+  return text;
+}
+
 ProgressReporter::ProgressReporter(std::string label, ProgressMode mode, std::FILE* out,
                                    double plain_interval)
     : label_(std::move(label)),

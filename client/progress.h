@@ -6,9 +6,12 @@
 // The formatting is pure (format_progress) so that tests check the text without a terminal.
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace penumbra {
 
@@ -33,6 +36,33 @@ std::string format_progress(const ProgressState& state, bool tty, int columns = 
 // "0.6 s", "1 min 05 s", "2 h 03 min".
 std::string format_duration(double seconds);
 
+// A farm job's progress as `watch` and `submit --wait` show it: the fields of its status
+// (penumbra.v1.JobStatus) it reads, copied so that this library needs no protobuf.
+struct JobProgress {
+  std::string job_id;
+  std::string state;  // its name, e.g. "running"
+  bool done = false;  // finished with its whole budget
+  uint32_t spp_budget = 0;
+  double seconds_budget = 0;
+  uint32_t passes_complete = 0;
+  uint32_t tiles_complete = 0, tiles_total = 0;
+  uint64_t tasks_complete = 0, tasks_total = 0, tasks_leased = 0;
+  double compute_seconds = 0, wall_seconds = 0;
+  std::optional<double> mrse;  // against the job's reference, when it has one
+};
+
+// The state to show: tasks done of the total for an spp budget, compute seconds of the budget
+// for a seconds one (short of it until the job is done: a spent budget still waits for the tasks
+// in flight); the rate in those units per wall second of the job (so the ETA holds for a job
+// that started before the watch); the spp, their rate, tiles, tasks leased, the MRSE and the
+// state as extra, e.g. "8 spp, 4 spp/s, tiles 1/4, leased 2, MRSE 0.0123, running".
+ProgressState job_progress_state(const JobProgress& job);
+
+// The MRSE of the jobs running now (a batch's: label and MRSE so far), at most `shown` of them:
+// "MRSE sa 0.0123, bsdf 0.0456 (+2 more)"; empty when there is none.
+std::string running_mrse_text(const std::vector<std::pair<std::string, double>>& running,
+                              size_t shown = 3);
+
 enum class ProgressMode { Auto, Terminal, Plain, Quiet };
 
 class ProgressReporter {
@@ -54,6 +84,7 @@ class ProgressReporter {
   void finish();
 
   bool terminal() const { return mode_ == ProgressMode::Terminal; }
+  bool quiet() const { return mode_ == ProgressMode::Quiet; }
   double elapsed() const;
 
  private:

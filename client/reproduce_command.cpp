@@ -9,10 +9,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 
 #include "client/commands.h"
+#include "client/progress.h"
 #include "core/analysis/reproduction_suite.h"
 #include "core/analysis/stability.h"
 
@@ -25,17 +27,27 @@ struct ReproduceArgs {
   std::string output = "reproduce-out";
   std::string scenes = PENUMBRA_SCENES_DIR;
   int threads = 0;
+  bool quiet = false;
 };
+
+// Progress of the experiments (or stability steps) on standard error: a bar with the steps done,
+// their rate and the ETA, and the one running; plain lines, one per step, when not a terminal.
+std::function<void(const std::string&, int, int)> step_progress(ProgressReporter& progress) {
+  return [&progress](const std::string& what, int done, int total) {
+    progress.update(done, total, "steps", done < total ? what : "");
+  };
+}
 
 void run_reproduce(const ReproduceArgs& args) {
   ReproductionOptions options;
   options.full = args.full;
   options.scenes_dir = args.scenes;
   options.threads = args.threads;
-  options.progress = [](const std::string& line) {
-    std::fprintf(stderr, "reproduce: %s\n", line.c_str());
-  };
+  ProgressReporter progress("reproduce", args.quiet ? ProgressMode::Quiet : ProgressMode::Auto,
+                            stderr, 0.0);
+  options.progress = step_progress(progress);
   ReproductionReport report = run_reproduction_suite(options);
+  progress.finish();
 
   std::printf("%s", format_reproduction_table(report).c_str());
   std::filesystem::create_directories(args.output);
@@ -60,16 +72,17 @@ void run_reproduce(const ReproduceArgs& args) {
 struct StabilityArgs {
   std::string output = "stability-out";
   int trials = 256, samples = 4;
+  bool quiet = false;
 };
 
 void run_stability_command(const StabilityArgs& args) {
   StabilityOptions options;
   options.trials = args.trials;
   options.samples = args.samples;
-  options.progress = [](const std::string& line) {
-    std::fprintf(stderr, "stability: %s\n", line.c_str());
-  };
+  ProgressReporter progress("stability", args.quiet ? ProgressMode::Quiet : ProgressMode::Auto);
+  options.progress = step_progress(progress);
   StabilityTable table = run_stability(options);
+  progress.finish();
   std::string markdown = stability_markdown(table);
   std::printf("%s", markdown.c_str());
   std::filesystem::create_directories(args.output);
@@ -105,6 +118,7 @@ void add_reproduce_command(CLI::App& app) {
   reproduce->add_option("--scenes", args->scenes, "Folder of the bundled scenes");
   reproduce->add_option("--threads", args->threads, "Threads (0: all cores)")
       ->check(CLI::Range(0, 1024));
+  reproduce->add_flag("--quiet,-q", args->quiet, "No progress (a bar on a terminal, else lines)");
   reproduce->callback([args] { run_reproduce(*args); });
 
   auto stability_args = std::make_shared<StabilityArgs>();
@@ -115,6 +129,8 @@ void add_reproduce_command(CLI::App& app) {
       ->check(CLI::Range(2, 1 << 20));
   stability->add_option("--samples", stability_args->samples, "Samples per estimate (N)")
       ->check(CLI::Range(1, 1 << 16));
+  stability->add_flag("--quiet,-q", stability_args->quiet,
+                      "No progress (a bar on a terminal, else lines)");
   stability->callback([stability_args] { run_stability_command(*stability_args); });
 }
 

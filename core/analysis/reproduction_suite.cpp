@@ -76,7 +76,8 @@ std::string visibility_figure(const std::string& title) {
 // sets its N (the paper's 256 in full mode), and it runs at most 20000 trials.
 void add_visibility_rows(const VisibilityReproductionOptions& options, int extreme_samples,
                          ReproductionReport& report, const ReproductionOptions& suite) {
-  if (suite.progress) suite.progress("visibility function: Figs. 4, 6, 7a, 7b, convergence");
+  if (suite.progress)
+    suite.progress("visibility function: Figs. 4, 6, 7a, 7b, convergence", 0, kReproductionSteps);
   Stopwatch clock;
   VisibilityReproductionOptions extreme = options;
   extreme.samples = extreme_samples;
@@ -286,7 +287,7 @@ std::string pixels_text(const PatternErrorStudy& study) {
 
 void add_fig8_rows(const ReproductionOptions& options, const RenderedSettings& settings,
                    ReproductionReport& report) {
-  if (options.progress) options.progress("grids-linear: Fig. 8");
+  if (options.progress) options.progress("grids-linear: Fig. 8", 1, kReproductionSteps);
   Stopwatch clock;
   auto scene = load_bundled(options, "grids-linear");
   const int n = 16;
@@ -341,12 +342,14 @@ void add_fig13_rows(const ReproductionOptions& options, const RenderedSettings& 
   // The paper's 50 samples: 64 on the square (8 x 8 strata; its disk rejects about 14 of them,
   // leaving 50 as in Sec. 7, footnote 8); the square and gaussian lights take all 64.
   const int n = 64;
+  int step = 2;
   for (Case c : {Case{"spheres-plane-square", "square", true, DiskSampling::Method, "area"},
                  Case{"spheres-plane-disk", "disk", false, DiskSampling::SquareRejection,
                       "rejection from the bounding square, as the paper"},
                  Case{"spheres-plane-gaussian", "gaussian", false, DiskSampling::Method,
                       "area, weighted by the profile"}}) {
-    if (options.progress) options.progress(std::string(c.scene) + ": Fig. 13");
+    if (options.progress)
+      options.progress(std::string(c.scene) + ": Fig. 13", step++, kReproductionSteps);
     Stopwatch clock;
     auto scene = load_bundled(options, c.scene);
     PatternSweep sweep = sweep_patterns(scene, {Pattern::UniformJitter, Pattern::Stratified},
@@ -410,7 +413,7 @@ void add_fig13_rows(const ReproductionOptions& options, const RenderedSettings& 
 
 void add_fig21_rows(const ReproductionOptions& options, const RenderedSettings& settings,
                     ReproductionReport& report) {
-  if (options.progress) options.progress("thin-fibers: Fig. 21");
+  if (options.progress) options.progress("thin-fibers: Fig. 21", 5, kReproductionSteps);
   Stopwatch clock;
   auto scene = load_bundled(options, "thin-fibers");
   const int n = 16;
@@ -446,7 +449,8 @@ void add_fig21_rows(const ReproductionOptions& options, const RenderedSettings& 
 // Peters 2021.
 
 void add_peters_rows(const ReproductionOptions& options, ReproductionReport& report) {
-  if (options.progress) options.progress("Peters 2021: psa variance and backward error");
+  if (options.progress)
+    options.progress("Peters 2021: psa variance and backward error", 6, kReproductionSteps);
   Stopwatch clock;
   int configurations = options.full ? 100000 : 10000;
   PsaVarianceResult variance = measure_psa_relative_deviation(configurations / 10, 16, 2021);
@@ -537,7 +541,8 @@ ProbePointSpec point_seen_from(const Scene& scene, const Vec3& position, const c
 
 void add_line_rows(const ReproductionOptions& options, ReproductionReport& report) {
   if (options.progress)
-    options.progress("line samples: Billen & Dutre Fig. 9, Salesin & Jarosz Figs. 5, 7");
+    options.progress("line samples: Billen & Dutre Fig. 9, Salesin & Jarosz Figs. 5, 7", 7,
+                     kReproductionSteps);
   const int trials = options.full ? 1024 : 128;
   const std::vector<int> counts = powers_of_two(4, options.full ? 256 : 64);
   auto scene = load_bundled(options, "quad-over-floor");
@@ -581,8 +586,8 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
       int index = 0;
       for (Vec3 position : {Vec3{0.05, 0, 0.1}, Vec3{-0.3, 0, 0.35}}) {
         ProbePointSpec p = point_seen_from(*grids, position, "ground");
-        VarianceConvergence lines = convergence_at_point(grids, p, "line-bd16:u",
-                                                         Pattern::Stratified, bd_counts, bd_trials, 9);
+        VarianceConvergence lines = convergence_at_point(
+            grids, p, "line-bd16:u", Pattern::Stratified, bd_counts, bd_trials, 9);
         VarianceConvergence points =
             convergence_at_point(grids, p, "sa", Pattern::Stratified, bd_counts, bd_trials, 9);
         lines_slope = std::max(lines_slope == 0 ? -1e9 : lines_slope, lines.deviation_slope());
@@ -663,9 +668,9 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
   // balance -1.36, smooth -1.32 in quick mode.)
   {
     auto strips = load_bundled(options, "glossy-strips");
-    const std::vector<int> fig7_counts =
-        options.full ? std::vector<int>{4, 16, 64, 256, 1024, 4096}
-                     : std::vector<int>{4, 16, 64, 256, 1024, 4096};
+    const std::vector<int> fig7_counts = options.full
+                                             ? std::vector<int>{4, 16, 64, 256, 1024, 4096}
+                                             : std::vector<int>{4, 16, 64, 256, 1024, 4096};
     const int fig7_trials = options.full ? 512 : 128;
     struct Fig7Case {
       const char* where;
@@ -683,8 +688,8 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
       const std::string tolerance = "smooth steeper by > " + format("%.1f", c.min_gain);
       try {
         ProbePointSpec p = point_seen_from(*strips, c.position, c.material);
-        VarianceConvergence plain = convergence_at_point(strips, p, "bsdf+line-sa:v",
-                                                         Pattern::Cmj, fig7_counts, fig7_trials, 2019);
+        VarianceConvergence plain = convergence_at_point(strips, p, "bsdf+line-sa:v", Pattern::Cmj,
+                                                         fig7_counts, fig7_trials, 2019);
         VarianceConvergence smooth = convergence_at_point(
             strips, p, "bsdf+line-sa:v/smooth", Pattern::Cmj, fig7_counts, fig7_trials, 2019);
         ReproductionRow row;
@@ -695,7 +700,7 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
                    format("%.3f", smooth.variance_slope);
         row.tolerance = tolerance;
         row.status = smooth.variance_slope < plain.variance_slope - c.min_gain ? RowStatus::Pass
-                                                                                : RowStatus::Fail;
+                                                                               : RowStatus::Fail;
         row.seconds = clock.seconds();
         report.rows.push_back(row);
         ChartSpec chart;
@@ -754,6 +759,7 @@ ReproductionReport run_reproduction_suite(const ReproductionOptions& options) {
   add_fig21_rows(options, settings, report);
   add_peters_rows(options, report);
   add_line_rows(options, report);
+  if (options.progress) options.progress("done", kReproductionSteps, kReproductionSteps);
   report.seconds = clock.seconds();
   return report;
 }

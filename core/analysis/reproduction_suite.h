@@ -54,12 +54,16 @@ struct ReproductionReport {
   bool passed() const;  // no row failed ("not available" and "info" rows do not fail)
 };
 
+// The experiments the suite runs, one progress step each.
+inline constexpr int kReproductionSteps = 8;
+
 struct ReproductionOptions {
   bool full = false;
   std::string scenes_dir;  // where grids-linear.json etc. live
   int threads = 0;         // 0: the hardware's count
-  // Called with a line of progress as each experiment starts (may be empty).
-  std::function<void(const std::string&)> progress;
+  // Called as each experiment starts with what it reproduces, the experiments done before it and
+  // their total (kReproductionSteps), and once more at the end with done == total (may be empty).
+  std::function<void(const std::string& what, int done, int total)> progress;
 };
 
 // Runs every experiment. Throws only for a broken installation (a scene missing from

@@ -363,6 +363,8 @@ StabilityTable run_stability(const StabilityOptions& options) {
   }
   table.methods = options.methods.empty() ? stability_methods() : options.methods;
 
+  int steps = int(table.methods.size() * table.cases.size()), done = 0;
+  for (const StabilityCase& c : table.cases) steps += !c.closed_form;
   // References: the closed form, or a converged bsdf+sa estimate with its standard error.
   std::vector<double> reference(table.cases.size()), reference_error(table.cases.size());
   std::vector<int> reference_trials(table.cases.size(), 0);  // 0: exact
@@ -372,7 +374,7 @@ StabilityTable run_stability(const StabilityOptions& options) {
       reference[i] = channel_mean(*c.closed_form);
       table.reference_kind.push_back("closed form");
     } else {
-      if (options.progress) options.progress("reference for " + c.name);
+      if (options.progress) options.progress("reference for " + c.name, done++, steps);
       Moments m = estimate(c, i, "bsdf+sa", options.reference_trials, options.reference_samples,
                            options.seed ^ 0xA5A5A5A5ull);
       if (m.nonfinite) throw std::runtime_error("the reference for " + c.name + " is not finite");
@@ -387,9 +389,9 @@ StabilityTable run_stability(const StabilityOptions& options) {
   }
 
   for (const std::string& method : table.methods) {
-    if (options.progress) options.progress(method);
     for (size_t i = 0; i < table.cases.size(); ++i) {
       const StabilityCase& c = table.cases[i];
+      if (options.progress) options.progress(method + " on " + c.name, done++, steps);
       StabilityCell cell;
       cell.method = method;
       cell.case_name = c.name;
@@ -432,6 +434,7 @@ StabilityTable run_stability(const StabilityOptions& options) {
       table.cells.push_back(cell);
     }
   }
+  if (options.progress) options.progress("done", steps, steps);
   return table;
 }
 

@@ -38,7 +38,9 @@ struct StabilityOptions {
   uint64_t seed = 7;
   std::vector<std::string> methods;  // empty: stability_methods()
   std::vector<std::string> cases;    // empty: every case
-  std::function<void(const std::string&)> progress;
+  // Called as each step (a reference, then a method on a case) starts with what it computes, the
+  // steps done before it and their total, and once more at the end with done == total.
+  std::function<void(const std::string& what, int done, int total)> progress;
 };
 
 struct StabilityCell {

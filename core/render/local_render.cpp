@@ -15,11 +15,14 @@ double process_cpu_seconds() {
   return double(ts.tv_sec) + ts.tv_nsec * 1e-9;
 }
 
-LocalRenderResult render_local(const Renderer& renderer, const RenderBudget& budget, int threads,
-                               int tile_size, const std::function<void(uint32_t, double)>& progress,
-                               const std::atomic<bool>* stop) {
+LocalRenderResult render_local(
+    const Renderer& renderer, const RenderBudget& budget, int threads, int tile_size,
+    const std::function<void(uint32_t, double)>& progress, const std::atomic<bool>* stop,
+    const std::function<void(std::span<const TileAccumulator>)>& inspect) {
   if (budget.spp == 0 && !(budget.seconds > 0))
     throw std::invalid_argument("a render needs a budget: spp >= 1 or seconds > 0");
+  if (uint64_t(budget.first_pass) + std::max(budget.spp, budget.max_spp) > (uint64_t(1) << 31))
+    throw std::invalid_argument("a render's passes must end below pass 2^31");
   const Camera& camera = renderer.scene().camera;
   LocalRenderResult result;
   std::vector<TileRect> rects = cut_tiles(camera.width, camera.height, tile_size);
@@ -43,11 +46,13 @@ LocalRenderResult render_local(const Renderer& renderer, const RenderBudget& bud
     if (target <= done) break;
     arena.execute([&] {
       tbb::parallel_for(size_t(0), rects.size(), [&](size_t t) {
-        renderer.render_tile(rects[t], done, target, result.tiles[t]);
+        renderer.render_tile(rects[t], budget.first_pass + done, budget.first_pass + target,
+                             result.tiles[t]);
       });
     });
     done = target;
     double spent = process_cpu_seconds() - cpu_start;
+    if (inspect) inspect(result.tiles);
     if (progress) progress(done, spent);
     if ((budget.spp > 0 && done >= budget.spp) || done >= budget.max_spp) break;
     if (budget.spp > 0) {

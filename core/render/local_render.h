@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <functional>
+#include <span>
 
 #include "core/render/film.h"
 #include "core/render/renderer.h"
@@ -15,6 +16,10 @@ struct RenderBudget {
   uint32_t spp = 0;    // render exactly this many passes, or
   double seconds = 0;  // pass blocks until this much compute (CPU) time is spent
   uint32_t max_spp = 1u << 20;
+  // The index of the first pass drawn: a render of passes [first_pass, first_pass + spp), which
+  // merges exactly with one of passes [0, first_pass) (core/render/sums_file.h). The counts above
+  // (spp, max_spp) are of passes drawn, not pass indices.
+  uint32_t first_pass = 0;
 };
 
 struct LocalRenderResult {
@@ -31,11 +36,14 @@ struct LocalRenderResult {
 // tenth of an spp budget, so that progress moves), and once *stop is true the render ends at the
 // next block boundary: every pixel then has the same whole passes, an unbiased image of
 // result.spp samples, bit-identical to a render of that many passes.
+// `inspect`, when given, is called after every pass block, before `progress`, with the tiles so
+// far (whole passes each): e.g. to measure the error of the image so far.
 inline constexpr double kStoppableBlockSeconds = 0.5;
-LocalRenderResult render_local(const Renderer& renderer, const RenderBudget& budget, int threads,
-                               int tile_size = 64,
-                               const std::function<void(uint32_t, double)>& progress = {},
-                               const std::atomic<bool>* stop = nullptr);
+LocalRenderResult render_local(
+    const Renderer& renderer, const RenderBudget& budget, int threads, int tile_size = 64,
+    const std::function<void(uint32_t, double)>& progress = {},
+    const std::atomic<bool>* stop = nullptr,
+    const std::function<void(std::span<const TileAccumulator>)>& inspect = {});
 
 // CPU time of the process (all threads), seconds.
 double process_cpu_seconds();

@@ -121,5 +121,59 @@ TEST(Progress, QuietWritesNothing) {
   std::fclose(file);
 }
 
+TEST(Progress, FarmJobShowsTasksOrComputeSecondsWithSppTilesAndMrse) {
+  JobProgress job;
+  job.job_id = "job-4";
+  job.state = "running";
+  job.spp_budget = 16;
+  job.passes_complete = 8;
+  job.tiles_complete = 1;
+  job.tiles_total = 4;
+  job.tasks_complete = 10;
+  job.tasks_total = 40;
+  job.tasks_leased = 2;
+  job.compute_seconds = 3;
+  job.wall_seconds = 2;
+  job.mrse = 0.0123;
+  // 10 of 40 tasks in the job's 2 wall seconds: 5 tasks/s, 30 more take 6 s.
+  EXPECT_EQ(format_progress(job_progress_state(job), false),
+            "job-4: 10/40 tasks (25%), 5 tasks/s, ETA 6.0 s, 8 spp, 4 spp/s, tiles 1/4, leased 2, "
+            "MRSE 0.0123, running");
+  EXPECT_EQ(format_progress(job_progress_state(job), true, 200, 8),
+            "[##------]  25%  10/40 tasks  5 tasks/s  ETA 6.0 s  8 spp, 4 spp/s, tiles 1/4, "
+            "leased 2, MRSE 0.0123, running  job-4");
+
+  // A seconds budget counts compute seconds, short of the budget until the job is done.
+  JobProgress timed = job;
+  timed.spp_budget = 0;
+  timed.seconds_budget = 4;
+  timed.compute_seconds = 5;  // spent, tasks still in flight
+  timed.mrse.reset();
+  timed.tasks_leased = 0;
+  ProgressState state = job_progress_state(timed);
+  EXPECT_EQ(state.unit, "compute s");
+  EXPECT_DOUBLE_EQ(state.done, 0.99 * 4);
+  EXPECT_EQ(state.extra, "8 spp, 4 spp/s, tiles 1/4, running");
+  timed.done = true;
+  timed.state = "done";
+  EXPECT_EQ(format_progress(job_progress_state(timed), false),
+            "job-4: 4/4 compute s (100%), 2 compute s/s, done in 2.0 s, 8 spp, 4 spp/s, tiles 1/4, "
+            "done");
+  // Queued: no total yet, no bar.
+  JobProgress queued;
+  queued.job_id = "job-5";
+  queued.state = "queued";
+  queued.spp_budget = 8;
+  EXPECT_EQ(format_progress(job_progress_state(queued), false),
+            "job-5: 0 tasks, 0 spp, tiles 0/0, queued");
+}
+
+TEST(Progress, RunningMrseListsAFewJobs) {
+  EXPECT_EQ(running_mrse_text({}), "");
+  EXPECT_EQ(running_mrse_text({{"sa", 0.0123}}), "MRSE sa 0.0123");
+  EXPECT_EQ(running_mrse_text({{"a", 1}, {"b", 2}, {"c", 0.5}, {"d", 4}, {"e", 5}}),
+            "MRSE a 1, b 2, c 0.5 (+2 more)");
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -1,7 +1,8 @@
 // Ctrl-C during `penumbra render`: the first SIGINT stops the render at a pass boundary and
 // writes the partial image, which states its spp and is bit-identical to a render of exactly that
-// many passes (whole passes: unbiased); a second SIGINT aborts without writing. Output that is
-// not a terminal gets plain progress lines.
+// many passes (whole passes: unbiased), and its exact sums, which merge with the passes after
+// them (`render --first-pass`, `penumbra merge`) into the bits of one uninterrupted render; a
+// second SIGINT aborts without writing. Output that is not a terminal gets plain progress lines.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -102,6 +103,25 @@ bool wait_for(const fs::path& file, const std::string& text) {
   return false;
 }
 
+int wait_exit(pid_t pid);
+
+// Runs `penumbra ARGS...` to its end with its output in `log`; returns its exit status.
+int run_penumbra(const fs::path& log, std::vector<std::string> args) {
+  args.insert(args.begin(), kPenumbra.string());
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  EXPECT_EQ(posix_spawn(&pid, kPenumbra.c_str(), &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  return wait_exit(pid);
+}
+
 int wait_exit(pid_t pid) {
   int status = 0;
   const auto deadline = Clock::now() + std::chrono::seconds(15);
@@ -174,6 +194,69 @@ TEST_F(RenderInterrupt, FirstCtrlCWritesTheWholePassesDone) {
   for (size_t i = 0; i < image.rgb.size(); ++i)
     different += image.rgb[i] != expected.film.color.rgb[i];
   EXPECT_EQ(different, 0u) << "of " << image.rgb.size() << " channels";
+}
+
+TEST_F(RenderInterrupt, PartialImageMergesWithTheRemainingPassesBitForBit) {
+  const fs::path exr = dir_ / "partial.exr";
+  Child child = start_render(dir_, scene_, exr);
+  ASSERT_TRUE(wait_for(child.err, "render interrupt-test: ")) << read_text(child.err);
+  kill(child.pid, SIGINT);
+  int status = wait_exit(child.pid);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130) << read_text(child.err);
+  const std::string out = read_text(child.out);
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(out, match, std::regex("partial image has (\\d+) spp"))) << out;
+  const uint32_t spp = uint32_t(std::stoul(match[1]));
+  // The sums are beside the EXR, and the message says how to go on.
+  const fs::path sums = dir_ / "partial.sums";
+  ASSERT_TRUE(fs::exists(sums));
+  EXPECT_NE(out.find("its exact sums are in " + sums.string() +
+                     ": render the remaining passes "
+                     "with --first-pass " +
+                     std::to_string(spp) + " --spp " + std::to_string(1000000 - spp)),
+            std::string::npos)
+      << out;
+
+  // The next 16 passes, later, with another tile size; then the merge (the EXR's sums found
+  // beside it).
+  const uint32_t more = 16;
+  ASSERT_EQ(run_penumbra(
+                dir_ / "rest.log",
+                {"render", scene_.string(), "--method", "sa", "--sampler", "stratified", "--seed",
+                 "7", "--first-pass", std::to_string(spp), "--spp", std::to_string(more), "--tile",
+                 "8", "--sums", (dir_ / "rest.sums").string(), "-o", (dir_ / "rest.exr").string()}),
+            0)
+      << read_text(dir_ / "rest.log");
+  const fs::path merged = dir_ / "merged.exr";
+  ASSERT_EQ(run_penumbra(dir_ / "merge.log", {"merge", exr.string(), (dir_ / "rest.sums").string(),
+                                              "-o", merged.string()}),
+            0)
+      << read_text(dir_ / "merge.log");
+  EXPECT_NE(read_text(dir_ / "merge.log")
+                .find("merged 2 part(s): passes 0.." + std::to_string(spp + more)),
+            std::string::npos)
+      << read_text(dir_ / "merge.log");
+
+  // One uninterrupted render of all those passes: the same bits, colour and variance.
+  ImageMetadata metadata;
+  Image variance;
+  Image image = read_exr(merged.string(), &metadata, &variance);
+  EXPECT_EQ(metadata["penumbra:spp"], std::to_string(spp + more));
+  EXPECT_EQ(metadata.count("penumbra:interrupted"), 0u);
+  auto scene = std::make_shared<const Scene>(load_scene(scene_.string()));
+  Renderer renderer(scene, RenderOptions{"sa", Pattern::Stratified, 7});
+  RenderBudget budget;
+  budget.spp = spp + more;
+  LocalRenderResult expected = render_local(renderer, budget, 2);
+  EXPECT_EQ(image.rgb, expected.film.color.rgb);
+  EXPECT_EQ(variance.rgb, expected.film.variance.rgb);
+
+  // A merge that would count passes twice is refused, naming the files.
+  EXPECT_NE(run_penumbra(dir_ / "twice.log", {"merge", sums.string(), sums.string(), "-o",
+                                              (dir_ / "twice.exr").string()}),
+            0);
+  EXPECT_NE(read_text(dir_ / "twice.log").find("a pass would count twice"), std::string::npos)
+      << read_text(dir_ / "twice.log");
 }
 
 TEST_F(RenderInterrupt, SecondCtrlCAborts) {

@@ -18,10 +18,14 @@ TEST(ReproductionSuite, QuickModeReproducesEveryFigure) {
   ReproductionOptions options;
   options.full = false;
   options.scenes_dir = std::string(PENUMBRA_SOURCE_DIR) + "/scenes";
-  options.progress = [](const std::string& line) {
-    std::printf("[ reproduce ] %s\n", line.c_str());
+  int steps = 0;
+  options.progress = [&](const std::string& line, int done, int total) {
+    EXPECT_EQ(done, steps++) << line;
+    EXPECT_EQ(total, kReproductionSteps);
+    std::printf("[ reproduce ] %d/%d %s\n", done, total, line.c_str());
   };
   ReproductionReport report = run_reproduction_suite(options);
+  EXPECT_EQ(steps, kReproductionSteps + 1);  // each experiment, then the end
   std::printf("%s\n", format_reproduction_table(report).c_str());
 
   ASSERT_FALSE(report.rows.empty());

@@ -23,6 +23,36 @@ const StabilityTable& table() {
   return t;
 }
 
+TEST(Stability, ProgressCountsEveryStepThenTheEnd) {
+  // Two cases (one without a closed form, whose reference is a step of its own) and two methods.
+  StabilityOptions options;
+  options.trials = 8;
+  options.reference_trials = 8;
+  options.reference_samples = 4;
+  options.methods = {"sa", "bsdf"};
+  // The first case with a closed form and the first without, in table order.
+  std::string with, without;
+  for (const StabilityCase& c : stability_cases()) {
+    std::string& slot = c.closed_form ? with : without;
+    if (!slot.empty()) continue;
+    slot = c.name;
+    options.cases.push_back(c.name);
+  }
+  ASSERT_EQ(options.cases.size(), 2u);
+  std::vector<std::string> steps;
+  int expected_done = 0;
+  options.progress = [&](const std::string& what, int done, int total) {
+    EXPECT_EQ(done, expected_done++) << what;
+    EXPECT_EQ(total, 1 + 2 * 2) << what;
+    steps.push_back(what);
+  };
+  run_stability(options);
+  ASSERT_EQ(steps.size(), 6u);
+  EXPECT_EQ(steps[0], "reference for " + without);
+  EXPECT_EQ(steps[1], "sa on " + options.cases[0]);
+  EXPECT_EQ(steps[5], "done");
+}
+
 TEST(Stability, EveryCaseHasAReferenceThatIsFinite) {
   for (const StabilityCase& c : stability_cases()) {
     if (c.closed_form) {
