@@ -223,7 +223,8 @@ std::string batch_viewer_html(Coordinator& coordinator, BatchManager& batches,
     note = std::string("No viewer yet: the reference is not ready (") + error.what() + ").";
     return "";
   }
-  Image reference = decode_exr(exr);
+  Image reference_variance;
+  Image reference = decode_exr(exr, nullptr, &reference_variance);
   std::map<std::string, Region> regions;
   ComparisonViewerContent content;
   content.width = reference.width;
@@ -242,10 +243,11 @@ std::string batch_viewer_html(Coordinator& coordinator, BatchManager& batches,
                        &reference,
                        {},
                        {},
-                       0};
-  std::vector<Image> images;
+                       0,
+                       reference_variance.width ? &reference_variance : nullptr};
+  std::vector<Image> images, variances;
   images.reserve(size_t(status.methods_size()));
-  std::vector<const Image*> pointers;
+  variances.reserve(size_t(status.methods_size()));
   for (const v1::BatchMethodStatus& method : status.methods()) {
     const v1::BatchRun* shown = nullptr;
     for (const v1::BatchRun& run : method.runs())
@@ -259,6 +261,7 @@ std::string batch_viewer_html(Coordinator& coordinator, BatchManager& batches,
                     : coordinator.preview_film(shown->job_id());
     if (film.color.width != reference.width || film.color.height != reference.height) continue;
     images.push_back(std::move(film.color));
+    variances.push_back(std::move(film.variance));
     ViewerImage image;
     image.label = method.label();
     image.method = method.method();
@@ -267,26 +270,17 @@ std::string batch_viewer_html(Coordinator& coordinator, BatchManager& batches,
     image.repeat = int(shown->repeat());
     image.compute_seconds = shown->job().compute_seconds();
     image.image = &images.back();
+    image.variance = variances.back().width == reference.width ? &variances.back() : nullptr;
     for (const auto& [region, summary] : error_summary(images.back(), reference, regions))
       image.mrse[region] = summary.mrse;
     content.methods.push_back(std::move(image));
-    pointers.push_back(&images.back());
   }
   if (content.methods.empty()) {
     note = "No viewer yet: no run has a complete pass.";
     return "";
   }
-  content.exposure = choose_exposure(reference);
-  // The relative error's scale: its 99th percentile over every method's image.
-  std::vector<float> errors;
-  for (const Image* image : pointers) {
-    Image map = relative_error_map(*image, reference);
-    for (size_t i = 0; i < map.rgb.size(); i += 3) errors.push_back(map.rgb[i]);
-  }
-  size_t index = std::min(errors.size() - 1, size_t(0.99 * double(errors.size())));
-  std::nth_element(errors.begin(), errors.begin() + ptrdiff_t(index), errors.end());
-  content.error_scale = errors[index] > 0 ? double(errors[index]) : 1.0;
-  content.difference_scale = choose_difference_scale(pointers, reference);
+  // The scales as the static report chooses them (core/report/comparison_viewer.h).
+  choose_viewer_scales(content);
   note.clear();
   return comparison_viewer_html(content);
 }
@@ -320,6 +314,7 @@ HttpAddress parse_http_address(const std::string& text) {
 void FarmMonitor::sample() {
   std::vector<v1::JobStatus> jobs = coordinator_.list();
   CoordinatorCounters counters = coordinator_.counters();
+  std::vector<v1::WorkerInfo> workers = coordinator_.workers();
   auto now = std::chrono::steady_clock::now();
   int64_t now_ms = unix_milliseconds_now();
   std::lock_guard lock(mutex_);
@@ -339,6 +334,43 @@ void FarmMonitor::sample() {
   // Keep one sample older than the longest window so a full minute is always covered.
   while (completions_.size() > 2 && now - completions_[1].first > std::chrono::seconds(61))
     completions_.pop_front();
+  std::set<std::string> known;
+  for (const v1::WorkerInfo& worker : workers) {
+    known.insert(worker.worker_id());
+    auto& samples = worker_completions_[worker.worker_id()];
+    samples.emplace_back(now, worker.tasks_completed());
+    while (samples.size() > 2 && now - samples[1].first > std::chrono::seconds(61))
+      samples.pop_front();
+  }
+  std::erase_if(worker_completions_, [&](const auto& entry) { return !known.count(entry.first); });
+}
+
+namespace {
+
+// Counts per second between the newest sample and the oldest inside `window` (or the oldest).
+double rate_over(
+    const std::deque<std::pair<std::chrono::steady_clock::time_point, uint64_t>>& samples,
+    std::chrono::seconds window) {
+  if (samples.size() < 2) return 0;
+  const auto& newest = samples.back();
+  auto oldest = samples.front();
+  for (const auto& sample : samples)
+    if (newest.first - sample.first <= window) {
+      oldest = sample;
+      break;
+    }
+  double seconds = std::chrono::duration<double>(newest.first - oldest.first).count();
+  if (seconds <= 0 || newest.second < oldest.second) return 0;
+  return double(newest.second - oldest.second) / seconds;
+}
+
+}  // namespace
+
+std::map<std::string, double> FarmMonitor::worker_rates(std::chrono::seconds window) {
+  std::lock_guard lock(mutex_);
+  std::map<std::string, double> rates;
+  for (const auto& [id, samples] : worker_completions_) rates[id] = rate_over(samples, window);
+  return rates;
 }
 
 double FarmMonitor::completion_rate(std::chrono::seconds window) {
@@ -347,18 +379,7 @@ double FarmMonitor::completion_rate(std::chrono::seconds window) {
 }
 
 double FarmMonitor::completion_rate_locked(std::chrono::seconds window) const {
-  if (completions_.size() < 2) return 0;
-  const auto& newest = completions_.back();
-  // The oldest sample inside the window (or the oldest there is).
-  auto oldest = completions_.front();
-  for (const auto& sample : completions_)
-    if (newest.first - sample.first <= window) {
-      oldest = sample;
-      break;
-    }
-  double seconds = std::chrono::duration<double>(newest.first - oldest.first).count();
-  if (seconds <= 0) return 0;
-  return double(newest.second - oldest.second) / seconds;
+  return rate_over(completions_, window);
 }
 
 std::string FarmMonitor::metrics_text() {
@@ -655,11 +676,19 @@ void HttpFrontend::route() {
     guarded_page(
         response,
         [&] {
+          v1::JobStatus status =
+              coordinator_.status(authorization.caller, request.matches[1], true);
+          std::map<std::string, double> rates = monitor_.worker_rates();
+          std::vector<JobPageWorker> workers;
+          for (v1::WorkerInfo& info : coordinator_.workers()) {
+            JobPageWorker worker;
+            worker.recent_tasks_per_second =
+                rates.count(info.worker_id()) ? rates[info.worker_id()] : 0;
+            worker.info = std::move(info);
+            workers.push_back(std::move(worker));
+          }
           response.set_header("Cache-Control", "no-store");
-          response.set_content(
-              job_page_html(coordinator_.status(authorization.caller, request.matches[1], true),
-                            query),
-              "text/html; charset=utf-8");
+          response.set_content(job_page_html(status, query, workers), "text/html; charset=utf-8");
         },
         query);
   });

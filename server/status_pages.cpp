@@ -2,11 +2,18 @@
 
 #include "server/status_pages.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
+#include "core/report/batch_charts.h"
 #include "core/report/batch_html.h"
 #include "proto/support/state_names.h"
 
@@ -23,6 +30,7 @@ th { background: #eee; } td.text, th.text { text-align: left; }
 .bar { width: 420px; height: 14px; border: 1px solid #888; background: #eee; display: inline-block;
   vertical-align: middle; } .bar span { display: block; height: 100%; background: #2c5d8f; }
 .error { color: #a00; } .note { font-size: 12px; color: #444; }
+.charts { display: flex; flex-wrap: wrap; gap: 12px; } figure { margin: 0; }
 img.preview { border: 1px solid #888; image-rendering: pixelated; max-width: 100%; }
 )";
 
@@ -69,51 +77,60 @@ void row(std::ostringstream& out, const std::string& key, const std::string& val
 
 }  // namespace
 
-std::string mrse_chart_svg(const v1::JobStatus& status, int width, int height) {
-  std::vector<std::pair<double, double>> points;
-  for (const v1::ErrorSample& sample : status.curve())
-    if (sample.compute_seconds() > 0 && sample.mrse() > 0 && std::isfinite(sample.mrse()))
-      points.emplace_back(std::log10(sample.compute_seconds()), std::log10(sample.mrse()));
-  if (points.size() < 2) return "";
-  double x0 = points[0].first, x1 = x0, y0 = points[0].second, y1 = y0;
-  for (const auto& [x, y] : points) {
-    x0 = std::min(x0, x);
-    x1 = std::max(x1, x);
-    y0 = std::min(y0, y);
-    y1 = std::max(y1, y);
-  }
-  if (x1 - x0 < 1e-9) x1 = x0 + 1;
-  if (y1 - y0 < 1e-9) y1 = y0 + 1;
-  const int left = 60, right = 12, top = 12, bottom = 36;
-  auto sx = [&](double x) { return left + (x - x0) / (x1 - x0) * (width - left - right); };
-  auto sy = [&](double y) { return top + (y1 - y) / (y1 - y0) * (height - top - bottom); };
-  std::ostringstream out;
-  out << "<svg class=\"chart\" xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width
-      << "\" height=\"" << height << "\" viewBox=\"0 0 " << width << " " << height << "\">\n"
-      << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << width - left - right
-      << "\" height=\"" << height - top - bottom << "\" fill=\"#fafafa\" stroke=\"#999\"/>\n";
-  out << "<path class=\"curve\" data-points=\"" << points.size()
-      << "\" fill=\"none\" stroke=\"#2c5d8f\" stroke-width=\"2\" d=\"";
-  for (size_t i = 0; i < points.size(); ++i)
-    out << (i ? " L" : "M") << number(sx(points[i].first), "%.1f") << ","
-        << number(sy(points[i].second), "%.1f");
-  out << "\"/>\n";
-  auto label = [&](double x, double y, const std::string& text, const char* anchor) {
-    out << "<text x=\"" << number(x, "%.1f") << "\" y=\"" << number(y, "%.1f")
-        << "\" font-size=\"11\" text-anchor=\"" << anchor << "\">" << html_escape(text)
-        << "</text>\n";
-  };
-  label(left, height - 20, number(std::pow(10, x0)) + " s", "start");
-  label(width - right, height - 20, number(std::pow(10, x1)) + " s", "end");
-  label(width / 2.0, height - 4, "compute seconds (log)", "middle");
-  label(left - 4, top + 10, number(std::pow(10, y1)), "end");
-  label(left - 4, height - bottom, number(std::pow(10, y0)), "end");
-  label(14, height / 2.0, "MRSE", "middle");
-  out << "</svg>\n";
-  return out.str();
+std::string chart_svg(const ChartSpec& spec) {
+  // A name no other request (thread or process) uses at the same time.
+  static std::atomic<uint64_t> counter{0};
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("penumbra-chart-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".svg");
+  struct Remove {
+    const std::filesystem::path& path;
+    ~Remove() {
+      std::error_code ignored;
+      std::filesystem::remove(path, ignored);
+    }
+  } remove{path};
+  write_line_chart(path.string(), spec);
+  std::ifstream file(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (text.empty()) throw std::runtime_error("chart " + path.string() + ": cannot read it back");
+  return text;
 }
 
-std::string job_page_html(const v1::JobStatus& status, const std::string& link_query) {
+std::vector<ChartSpec> job_convergence_charts(const v1::JobStatus& status) {
+  // A batch of this one run, so that the charts are the report's own.
+  BatchResult result;
+  BatchMethod method;
+  method.label = status.method();
+  method.method = status.method();
+  method.sampler = status.sampler();
+  BatchRun run;
+  run.job_id = status.job_id();
+  run.spp = status.passes_complete();
+  run.compute_seconds = status.compute_seconds();
+  run.wall_seconds = status.wall_seconds();
+  for (const v1::ErrorSample& sample : status.curve())
+    if (sample.mrse() > 0 && std::isfinite(sample.mrse()))
+      run.curve.push_back(
+          {sample.passes(), sample.compute_seconds(), sample.wall_seconds(), sample.mrse()});
+  if (run.curve.empty()) return {};
+  ErrorSummary last;
+  last.mrse = run.curve.back().mrse;
+  run.errors["image"] = last;
+  method.runs.push_back(run);
+  result.methods.push_back(method);
+  const RecomputedErrors recomputed = {{run.errors}};
+  std::vector<ChartSpec> charts = {mrse_time_chart(result, recomputed),
+                                   mrse_spp_chart(result, recomputed, "image")};
+  for (ChartSpec& chart : charts) {
+    chart.width = 480;
+    chart.height = 340;
+  }
+  return charts;
+}
+
+std::string job_page_html(const v1::JobStatus& status, const std::string& link_query,
+                          const std::vector<JobPageWorker>& workers) {
   const std::string q = html_escape(link_query);
   std::ostringstream out;
   const std::string title =
@@ -162,11 +179,64 @@ std::string job_page_html(const v1::JobStatus& status, const std::string& link_q
          "src=\"/api/jobs/"
       << html_escape(status.job_id()) << "/preview.png" << q << "\" width=\"" << status.width()
       << "\" height=\"" << status.height() << "\">\n";
-  std::string chart = mrse_chart_svg(status);
-  if (!chart.empty())
+  // Tasks by state: complete, held by a worker (rendering), waiting for one.
+  const uint64_t leased = status.tasks_leased();
+  const uint64_t waiting = status.tasks_total() > status.tasks_complete() + leased
+                               ? status.tasks_total() - status.tasks_complete() - leased
+                               : 0;
+  out << "<h2>Tasks</h2>\n<table id=\"tasks\" data-complete=\"" << status.tasks_complete()
+      << "\" data-leased=\"" << leased << "\" data-waiting=\"" << waiting
+      << "\">\n<tr><th class=\"text\">state</th><th>tasks</th></tr>\n"
+      << "<tr><td class=\"text\">complete</td><td>" << status.tasks_complete() << "</td></tr>\n"
+      << "<tr><td class=\"text\">rendering (leased to a worker)</td><td>" << leased
+      << "</td></tr>\n"
+      << "<tr><td class=\"text\">waiting for a worker</td><td>" << waiting << "</td></tr>\n"
+      << "<tr><th class=\"text\">opened so far</th><th>" << status.tasks_total()
+      << "</th></tr>\n</table>\n";
+
+  out << "<h2>Workers</h2>\n";
+  if (workers.empty()) {
+    out << "<p class=\"note\">No worker has registered.</p>\n";
+  } else {
+    out << "<p class=\"note\">Every worker the coordinator knows: the tasks it renders now and "
+           "its throughput over the last minute (of any job; this job holds "
+        << leased << " of the tasks leased).</p>\n"
+        << "<table id=\"workers\">\n<tr><th class=\"text\">worker</th><th "
+           "class=\"text\">state</th><th>threads</th><th>tasks now</th><th>recent "
+           "tasks/s</th><th>tasks done</th><th>compute s</th></tr>\n";
+    for (const JobPageWorker& worker : workers) {
+      const v1::WorkerInfo& info = worker.info;
+      out << "<tr data-worker=\"" << html_escape(info.worker_id()) << "\"><td class=\"text\">"
+          << html_escape(info.name().empty() ? info.worker_id() : info.name())
+          << "</td><td class=\"text\">" << (info.alive() ? "alive" : "lost") << "</td><td>"
+          << info.threads() << "</td><td>" << info.tasks_leased() << "</td><td>"
+          << number(worker.recent_tasks_per_second, "%.3g") << "</td><td>" << info.tasks_completed()
+          << "</td><td>" << number(info.compute_seconds(), "%.1f") << "</td></tr>\n";
+    }
+    out << "</table>\n";
+  }
+
+  // The convergence charts, as the batch report draws them (SVG as data: URIs, as there).
+  std::vector<ChartSpec> charts = job_convergence_charts(status);
+  if (!charts.empty()) {
     out << "<h2>Convergence</h2>\n<p class=\"note\">MRSE against the reference at each pass "
-           "boundary, against compute seconds (log-log).</p>\n"
-        << chart;
+           "boundary, against compute seconds and against spp (log-log).</p>\n<div "
+           "class=\"charts\">\n";
+    for (const ChartSpec& chart : charts) {
+      std::string svg;
+      try {
+        svg = chart_svg(chart);
+      } catch (const std::exception& error) {
+        out << "<p class=\"note\">" << html_escape(chart.title) << ": " << html_escape(error.what())
+            << "</p>\n";
+        continue;
+      }
+      out << "<figure><img class=\"chart\" alt=\"" << html_escape(chart.title)
+          << "\" src=\"data:image/svg+xml;base64," << base64_encode(svg) << "\"><figcaption "
+          << "class=\"note\">" << html_escape(chart.title) << "</figcaption></figure>\n";
+    }
+    out << "</div>\n";
+  }
   if (status.curve_size() > 0) {
     out << "<table id=\"curve\">\n<tr><th>passes</th><th>compute s</th><th>wall s</th>"
            "<th>MRSE</th></tr>\n";
@@ -195,8 +265,16 @@ std::string batch_page_html(const v1::BatchStatus& status, const std::string& vi
   std::ostringstream out;
   const std::string title =
       "Batch " + status.batch_id() + (status.name().empty() ? "" : ": " + status.name());
-  out << head(title, !finished(status.state())) << "<h1>" << html_escape(title) << "</h1>\n"
-      << "<p class=\"note\"><a href=\"/" << q << "\">dashboard</a></p>\n";
+  // A refresh would reset the viewer (its method, zoom and exposure): a running batch's page
+  // with the viewer links to its newer state instead.
+  const bool running = !finished(status.state());
+  out << head(title, running && viewer_html.empty()) << "<h1>" << html_escape(title) << "</h1>\n"
+      << "<p class=\"note\"><a href=\"/" << q << "\">dashboard</a>";
+  if (running && !viewer_html.empty())
+    out << " · <span id=\"stale\">running: this page shows the images at " +
+               number(status.wall_seconds(), "%.1f") + " wall s; <a href=\"/batches/" +
+               html_escape(status.batch_id()) + q + "\">reload</a> for the newer passes</span>";
+  out << "</p>\n";
   out << "<table id=\"batch\" data-state=\"" << farm::state_name(status.state())
       << "\" data-jobs-done=\"" << status.jobs_done() << "\">\n";
   row(out, "state", "<b>" + farm::state_name(status.state()) + "</b>");

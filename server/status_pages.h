@@ -2,13 +2,19 @@
 // Server-rendered pages of one job and one batch, served by server/http_frontend.h at
 // GET /jobs/<id> and GET /batches/<id>. Everything is in the HTML as sent (no script needed):
 // state, progress bar, rates and ETA, errors, the live preview (an <img> of
-// /api/jobs/<id>/preview.png), the MRSE-against-time chart as inline SVG, and for a batch its
+// /api/jobs/<id>/preview.png), its tasks by state, the farm's workers with the tasks they hold
+// and their recent throughput, the convergence charts (MRSE against compute seconds and against
+// spp, drawn by the batch report's chart code, core/report/batch_charts.h), and for a batch its
 // methods, runs (linked to their job pages) and refusals, with the comparison viewer
-// (core/report/comparison_viewer.h) of its images when the reference is there. A page whose job
-// or batch still runs refreshes itself every 2 seconds (<meta http-equiv="refresh">).
+// (core/report/comparison_viewer.h, the static report's) of its images when the reference is
+// there. A job page, or a batch page without the viewer, refreshes itself every 2 seconds while
+// its job or batch runs (<meta http-equiv="refresh">); a running batch's page with the viewer
+// does not (a refresh would reset the viewer) and links to its newer state instead.
 
 #include <string>
+#include <vector>
 
+#include "core/image/chart.h"
 #include "penumbra/v1/farm.pb.h"
 
 namespace penumbra::farm {
@@ -17,7 +23,14 @@ namespace penumbra::farm {
 // `link_query` ("?token=..." URL-encoded, or empty) is appended to every link and image address
 // the page holds, so a browser that came with its token in the address keeps it (see
 // server/http_frontend.h).
-std::string job_page_html(const v1::JobStatus& status, const std::string& link_query = "");
+// A worker as a job page lists it: what the coordinator knows of it (with the tasks it holds
+// now) and its recent throughput, measured by the HTTP side over the last minute.
+struct JobPageWorker {
+  v1::WorkerInfo info;
+  double recent_tasks_per_second = 0;  // completions of any job's tasks
+};
+std::string job_page_html(const v1::JobStatus& status, const std::string& link_query = "",
+                          const std::vector<JobPageWorker>& workers = {});
 // `viewer_html`: the viewer's section, or empty; `viewer_note` says why there is none.
 std::string batch_page_html(const v1::BatchStatus& status, const std::string& viewer_html,
                             const std::string& viewer_note, const std::string& link_query = "");
@@ -25,8 +38,11 @@ std::string batch_page_html(const v1::BatchStatus& status, const std::string& vi
 std::string error_page_html(int http_status, const std::string& message,
                             const std::string& link_query = "");
 
-// The MRSE curve as an inline SVG (log-log MRSE against compute seconds); empty without two
-// positive points.
-std::string mrse_chart_svg(const v1::JobStatus& status, int width = 480, int height = 260);
+// A job's convergence charts, MRSE (full image) against compute seconds and against spp, from
+// its pass-boundary curve: the batch report's charts (mrse_time_chart, mrse_spp_chart) of a
+// batch of this one run. None when the curve is empty.
+std::vector<ChartSpec> job_convergence_charts(const v1::JobStatus& status);
+// A chart as SVG text, drawn by core/image/chart.h through a temporary file (removed).
+std::string chart_svg(const ChartSpec& spec);
 
 }  // namespace penumbra::farm

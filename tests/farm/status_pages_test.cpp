@@ -1,6 +1,8 @@
 // The coordinator's job and batch pages: the HTML built from status messages (state, progress,
-// errors escaped, preview, chart, runs linked to their jobs, refusals, self-refresh only while
-// running), and the routes served by a real coordinator's HTTP side (a job's page, 404 pages).
+// errors escaped, preview, tasks by state, workers with their throughput, the report's
+// convergence charts, runs linked to their jobs, refusals, self-refresh only while running and
+// never over the viewer), and the routes served by a real coordinator's HTTP side (a job's
+// page with its tasks and workers, 404 pages).
 // Built only with the farm (PENUMBRA_FARM=ON); otherwise the program reports a skipped test.
 #if __has_include("penumbra/v1/farm.pb.h")
 #include "server/status_pages.h"
@@ -31,6 +33,7 @@ v1::JobStatus running_job() {
   status.set_passes_planned(16);
   status.set_tasks_total(4);
   status.set_tasks_complete(1);
+  status.set_tasks_leased(2);
   status.set_wall_seconds(2);
   status.set_compute_seconds(3.5);
   for (uint32_t passes : {2u, 4u, 8u}) {
@@ -43,7 +46,16 @@ v1::JobStatus running_job() {
 }
 
 TEST(StatusPages, JobPageShowsProgressPreviewChartAndRefreshesWhileRunning) {
-  std::string html = job_page_html(running_job());
+  std::vector<JobPageWorker> workers(2);
+  workers[0].info.set_worker_id("w-1");
+  workers[0].info.set_name("box <1>");
+  workers[0].info.set_alive(true);
+  workers[0].info.set_threads(8);
+  workers[0].info.set_tasks_completed(120);
+  workers[0].info.set_tasks_leased(2);
+  workers[0].recent_tasks_per_second = 1.5;
+  workers[1].info.set_worker_id("w-2");
+  std::string html = job_page_html(running_job(), "", workers);
   EXPECT_NE(html.find("<title>Job job-7: a &lt;b&gt; job</title>"), std::string::npos);
   EXPECT_NE(html.find("<meta http-equiv=\"refresh\" content=\"2\">"), std::string::npos);
   EXPECT_NE(html.find("data-state=\"running\" data-passes=\"8\""), std::string::npos);
@@ -52,7 +64,25 @@ TEST(StatusPages, JobPageShowsProgressPreviewChartAndRefreshesWhileRunning) {
   EXPECT_NE(html.find("4 spp/s"), std::string::npos);  // 8 passes in 2 wall s
   EXPECT_NE(html.find("ETA 6 s"), std::string::npos);  // 2 s x (1 - 1/4) / (1/4)
   EXPECT_NE(html.find("src=\"/api/jobs/job-7/preview.png\""), std::string::npos);
-  EXPECT_NE(html.find("<path class=\"curve\" data-points=\"3\""), std::string::npos);
+  // Tasks by state: 1 complete, 2 leased, 1 waiting of the 4 opened.
+  EXPECT_NE(html.find("data-complete=\"1\" data-leased=\"2\" data-waiting=\"1\""),
+            std::string::npos);
+  // Workers: escaped names, the tasks they hold and the recent rate; a lost one says so.
+  EXPECT_NE(html.find("<tr data-worker=\"w-1\"><td class=\"text\">box &lt;1&gt;</td><td "
+                      "class=\"text\">alive</td><td>8</td><td>2</td><td>1.5</td><td>120</td>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<tr data-worker=\"w-2\"><td class=\"text\">w-2</td><td "
+                      "class=\"text\">lost</td>"),
+            std::string::npos);
+  // Both convergence charts, as SVG data URIs.
+  size_t charts = 0;
+  for (size_t at = html.find("<img class=\"chart\""); at != std::string::npos;
+       at = html.find("<img class=\"chart\"", at + 1))
+    ++charts;
+  EXPECT_EQ(charts, 2u);
+  EXPECT_NE(html.find("alt=\"MRSE against spp, full image\" src=\"data:image/svg+xml;base64,"),
+            std::string::npos);
   EXPECT_EQ(html.find("<script"), std::string::npos);
 
   v1::JobStatus failed = running_job();
@@ -63,11 +93,26 @@ TEST(StatusPages, JobPageShowsProgressPreviewChartAndRefreshesWhileRunning) {
   EXPECT_NE(html.find("<span class=\"error\">worker said &lt;no&gt;</span>"), std::string::npos);
 }
 
-TEST(StatusPages, ChartNeedsTwoPositivePoints) {
+TEST(StatusPages, ConvergenceChartsAreTheReportsOfTheJobsCurve) {
   v1::JobStatus status = running_job();
-  EXPECT_NE(mrse_chart_svg(status).find("<svg"), std::string::npos);
-  status.mutable_curve()->DeleteSubrange(1, 2);
-  EXPECT_EQ(mrse_chart_svg(status), "");
+  std::vector<ChartSpec> charts = job_convergence_charts(status);
+  ASSERT_EQ(charts.size(), 2u);
+  // Against compute seconds: the curve's points (0.5 s per pass), log-log.
+  EXPECT_TRUE(charts[0].log_x && charts[0].log_y);
+  EXPECT_EQ(charts[0].x_label, "compute seconds");
+  ASSERT_EQ(charts[0].series.size(), 1u);
+  EXPECT_EQ(charts[0].series[0].x, (std::vector<double>{1, 2, 4}));
+  EXPECT_EQ(charts[0].series[0].y, (std::vector<double>{0.5, 0.25, 0.125}));
+  // Against spp, with the fitted convergence rate: MRSE = 1 / spp has slope -1.
+  EXPECT_EQ(charts[1].x_label, "samples per pixel");
+  ASSERT_EQ(charts[1].series.size(), 1u);
+  EXPECT_EQ(charts[1].series[0].x, (std::vector<double>{2, 4, 8}));
+  ASSERT_TRUE(charts[1].series[0].fit.has_value());
+  EXPECT_NEAR(charts[1].series[0].fit->slope, -1.0, 1e-12);
+  EXPECT_NE(chart_svg(charts[1]).find("<svg"), std::string::npos);
+  // No curve yet: no chart.
+  status.clear_curve();
+  EXPECT_TRUE(job_convergence_charts(status).empty());
 }
 
 TEST(StatusPages, BatchPageListsRunsRefusalsAndTheViewer) {
@@ -95,9 +140,17 @@ TEST(StatusPages, BatchPageListsRunsRefusalsAndTheViewer) {
   EXPECT_NE(html.find("<a href=\"/jobs/job-9\">job-9</a>"), std::string::npos);
   EXPECT_NE(html.find("refused: material &#39;x&#39; is ggx"), std::string::npos);
   EXPECT_NE(html.find("No viewer yet: the reference is not ready."), std::string::npos);
+  // Running with the viewer: no refresh (it would reset the viewer), a link to reload instead.
+  html = batch_page_html(status, "<section id=\"viewer\"></section>", "");
+  EXPECT_EQ(html.find("http-equiv=\"refresh\""), std::string::npos);
+  EXPECT_NE(html.find("this page shows the images at 10.0 wall s; <a href=\"/batches/batch-3\">"
+                      "reload</a>"),
+            std::string::npos)
+      << html;
   status.set_state(v1::BATCH_STATE_DONE);
   html = batch_page_html(status, "<section id=\"viewer\"></section>", "");
   EXPECT_EQ(html.find("http-equiv=\"refresh\""), std::string::npos);
+  EXPECT_EQ(html.find("reload"), std::string::npos);
   EXPECT_NE(html.find("<section id=\"viewer\"></section>"), std::string::npos);
 }
 
@@ -116,6 +169,8 @@ TEST(StatusPages, CoordinatorServesJobPagesAndErrorPages) {
   EXPECT_EQ(page->get_header_value("Content-Type"), "text/html; charset=utf-8");
   EXPECT_NE(page->body.find("data-state=\"queued\""), std::string::npos) << page->body;
   EXPECT_NE(page->body.find("0 complete of 8 planned"), std::string::npos) << page->body;
+  EXPECT_NE(page->body.find("<table id=\"tasks\""), std::string::npos) << page->body;
+  EXPECT_NE(page->body.find("No worker has registered."), std::string::npos) << page->body;
   auto missing = client.Get("/jobs/no-such-job");
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->status, 404);
