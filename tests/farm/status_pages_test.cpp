@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include "fake_worker.h"
 #include "farm_test_support.h"
 #include "proto/support/scene_packing.h"
 #include "server/coordinator.h"
@@ -171,6 +172,30 @@ TEST(StatusPages, CoordinatorServesJobPagesAndErrorPages) {
   EXPECT_NE(page->body.find("0 complete of 8 planned"), std::string::npos) << page->body;
   EXPECT_NE(page->body.find("<table id=\"tasks\""), std::string::npos) << page->body;
   EXPECT_NE(page->body.find("No worker has registered."), std::string::npos) << page->body;
+
+  // A worker that completes one of its two tasks: its row on the page, and its rate over the
+  // monitor's samples (one completion between two samples).
+  FarmMonitor monitor(coordinator);
+  const std::string worker = testing::register_fake_worker(coordinator, "page-worker");
+  monitor.sample();
+  std::vector<v1::Task> tasks = testing::lease_tasks(coordinator, worker, 2);
+  ASSERT_EQ(tasks.size(), 2u);
+  ASSERT_TRUE(testing::complete_fake_task(coordinator, worker, tasks[0], 0.5));
+  const auto before = std::chrono::steady_clock::now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  monitor.sample();
+  const double rate = monitor.worker_rates().at(worker);
+  EXPECT_GT(rate, 0.0);
+  EXPECT_LE(rate,
+            1.0 / std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count());
+  page = client.Get("/jobs/" + job);
+  ASSERT_TRUE(page);
+  EXPECT_NE(page->body.find("<tr data-worker=\"" + worker +
+                            "\"><td class=\"text\">page-worker</td><td class=\"text\">alive</td>"
+                            "<td>1</td><td>1</td>"),
+            std::string::npos)
+      << page->body;
+  EXPECT_NE(page->body.find("data-complete=\"1\" data-leased=\"1\""), std::string::npos);
   auto missing = client.Get("/jobs/no-such-job");
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->status, 404);
