@@ -220,12 +220,22 @@ TEST_F(RenderInterrupt, PartialImageMergesWithTheRemainingPassesBitForBit) {
   // The next 16 passes, later, with another tile size; then the merge (the EXR's sums found
   // beside it).
   const uint32_t more = 16;
-  ASSERT_EQ(run_penumbra(
-                dir_ / "rest.log",
-                {"render", scene_.string(), "--method", "sa", "--sampler", "stratified", "--seed",
-                 "7", "--first-pass", std::to_string(spp), "--spp", std::to_string(more), "--tile",
-                 "8", "--sums", (dir_ / "rest.sums").string(), "-o", (dir_ / "rest.exr").string()}),
+  ASSERT_EQ(run_penumbra(dir_ / "rest.log", {"render",       scene_.string(),
+                                             "--method",     "sa",
+                                             "--sampler",    "stratified",
+                                             "--seed",       "7",
+                                             "--first-pass", std::to_string(spp),
+                                             "--spp",        std::to_string(more),
+                                             "--tile",       "8",
+                                             "--reference",  exr.string(),
+                                             "--sums",       (dir_ / "rest.sums").string(),
+                                             "-o",           (dir_ / "rest.exr").string()}),
             0)
+      << read_text(dir_ / "rest.log");
+  // With a reference, the progress lines carry the MRSE of the image so far.
+  EXPECT_TRUE(std::regex_search(read_text(dir_ / "rest.log"),
+                                std::regex("render interrupt-test: 16/16 spp \\(100%\\), .*, "
+                                           "MRSE [0-9.e+-]+\n")))
       << read_text(dir_ / "rest.log");
   const fs::path merged = dir_ / "merged.exr";
   ASSERT_EQ(run_penumbra(dir_ / "merge.log", {"merge", exr.string(), (dir_ / "rest.sums").string(),
