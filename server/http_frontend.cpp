@@ -147,13 +147,10 @@ int http_status(FarmErrorCode code) {
   return 500;
 }
 
-// Runs a handler body; domain errors become their HTTP status with a JSON error body.
-template <typename Body>
-void guarded(httplib::Response& response, Body&& body) {
-  auto fail = [&](int status, const std::string& message) {
-    response.status = status;
-    response.set_content(nlohmann::json{{"error", message}}.dump() + "\n", "application/json");
-  };
+// Runs a handler body; an exception becomes fail(HTTP status, message): a domain error's own
+// status, 500 for anything else.
+template <typename Body, typename Fail>
+void run_guarded(Body&& body, Fail&& fail) {
   try {
     body();
   } catch (const FarmError& error) {
@@ -161,6 +158,15 @@ void guarded(httplib::Response& response, Body&& body) {
   } catch (const std::exception& error) {
     fail(500, error.what());
   }
+}
+
+// Runs a handler body; domain errors become their HTTP status with a JSON error body.
+template <typename Body>
+void guarded(httplib::Response& response, Body&& body) {
+  run_guarded(body, [&](int status, const std::string& message) {
+    response.status = status;
+    response.set_content(nlohmann::json{{"error", message}}.dump() + "\n", "application/json");
+  });
 }
 
 void set_json(httplib::Response& response, const std::string& json) {
@@ -171,17 +177,10 @@ void set_json(httplib::Response& response, const std::string& json) {
 // A page for a domain error: the error's HTTP status and message.
 template <typename Body>
 void guarded_page(httplib::Response& response, Body&& body, const std::string& link_query = "") {
-  auto fail = [&](int status, const std::string& message) {
+  run_guarded(body, [&](int status, const std::string& message) {
     response.status = status;
     response.set_content(error_page_html(status, message, link_query), "text/html; charset=utf-8");
-  };
-  try {
-    body();
-  } catch (const FarmError& error) {
-    fail(http_status(error.code()), error.what());
-  } catch (const std::exception& error) {
-    fail(500, error.what());
-  }
+  });
 }
 
 // A query parameter's value percent-encoded (RFC 3986 unreserved characters kept).

@@ -312,6 +312,13 @@ uint64_t Store::add_job(const JobRecord& job) {
   return uint64_t(sqlite3_last_insert_rowid(db_));
 }
 
+void Store::write_job_spec(const JobRecord& job) {
+  Statement(*this, "UPDATE jobs SET spec = ? WHERE id = ?")
+      .bind_blob(1, job.spec)
+      .bind(2, int64_t(job.id))
+      .run();
+}
+
 void Store::write_job_fields(const JobRecord& job) {
   Statement(*this,
             "UPDATE jobs SET state = ?, error = ?, started_ms = ?, finished_ms = ?, "
@@ -338,10 +345,7 @@ void Store::update_job_spec(const JobRecord& job) {
   std::lock_guard lock(mutex_);
   write_progress([&] {
     Transaction transaction(*this);
-    Statement(*this, "UPDATE jobs SET spec = ? WHERE id = ?")
-        .bind_blob(1, job.spec)
-        .bind(2, int64_t(job.id))
-        .run();
+    write_job_spec(job);
     write_job_fields(job);
     transaction.commit();
   });
@@ -519,10 +523,7 @@ void Store::cancel_job(const JobRecord& job, const std::optional<std::string>& e
   std::lock_guard lock(mutex_);
   write_progress([&] {
     Transaction transaction(*this);
-    Statement(*this, "UPDATE jobs SET spec = ? WHERE id = ?")
-        .bind_blob(1, job.spec)
-        .bind(2, int64_t(job.id))
-        .run();
+    write_job_spec(job);
     if (exr)
       Statement(*this, "UPDATE jobs SET result = ? WHERE id = ?")
           .bind_blob(1, *exr)

@@ -128,6 +128,7 @@ class Store {
   class Transaction;
   void execute(const char* sql);
   void write_job_fields(const JobRecord& job);
+  void write_job_spec(const JobRecord& job);
   // Throws FarmError(ResourceExhausted, "disk full: ...") when the last failure of the
   // connection was a lack of space, std::runtime_error otherwise.
   [[noreturn]] void throw_error(int code, const std::string& context);
