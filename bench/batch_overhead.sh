@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Batch overhead (issue #7 benchmark): a 4-method batch with a budget of 10 compute seconds per
+# Batch overhead: a 4-method batch with a budget of 10 compute seconds per
 # method on one worker with one render thread. Goal: the batch's wall time (submission to done,
 # calibration included) within 15% of the 40 s of compute its equal-time runs are budgeted.
 # The reference is rendered first by a warm-up batch and then reused from the cache, so it is

@@ -1,4 +1,4 @@
-// Time to recover (issue #8's benchmark), on real processes on loopback:
+// Time to recover, on real processes on loopback:
 //  - CoordinatorRestartToFirstLease: a penumbra-coordinator process running a job with two
 //    penumbra-worker processes is SIGKILLed and started again on its data directory and port;
 //    time from the restart (spawn) to the first task a worker holds again (ListWorkers shows a

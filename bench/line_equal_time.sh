@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Equal-time MRSE of the line methods (issue #3) on cornell-occluders and monoliths: sa, bsdf+sa,
+# Equal-time MRSE of the line methods on cornell-occluders and monoliths: sa, bsdf+sa,
 # line-sa:v, line-bd16:rand, bsdf+line-sa:v/balance and bsdf+line-sa:v/smooth, each rendered by
 # `penumbra render --seconds` for the same compute (CPU) time, against a long bsdf+sa reference.
 # Prints one markdown table per scene: method, spp reached, compute seconds, MRSE of the whole

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Equal-time MRSE of the polygon methods on polygon-cornell and occluded-planes (issue #4):
+# Equal-time MRSE of the polygon methods on polygon-cornell and occluded-planes:
 # sa, psa, bsdf+sa, psa+ltc/weighted and psa+ltc/clamped-optimal, each rendered by
 # `penumbra render --seconds` for the same compute (CPU) time, against a long bsdf+sa reference.
 # Prints a markdown table (MRSE of the whole image and of each region; lower is better).

@@ -1,4 +1,4 @@
-// The client's batch commands (issue #7): `penumbra batch submit|watch|status|list|cancel|fetch|
+// The client's batch commands: `penumbra batch submit|watch|status|list|cancel|fetch|
 // run` and `penumbra report`. They talk to the coordinator's Batches service
 // (proto/support/batch_client.h) named by --coordinator or PENUMBRA_COORDINATOR, with TLS and a
 // token as the farm commands take them; `batch run` without --coordinator starts an embedded

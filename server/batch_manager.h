@@ -1,5 +1,5 @@
 #pragma once
-// The coordinator's batches (issue #7): an equal-time comparison of several methods on one
+// The coordinator's batches: an equal-time comparison of several methods on one
 // scene (core/batch/batch_spec.h), run as jobs of the Coordinator. No gRPC here: the service
 // (server/batch_service.h) translates calls; errors are FarmError and FormatError.
 //

@@ -571,8 +571,8 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
   // Billen & Dutré Fig. 9: slope of the standard deviation, stratified, on their grid-planes
   // scene: ground points in the grids' shadow, where several bars' shadows cross the light at
   // all orientations. (On quad-over-floor, whose shadow edges run parallel to the lines, the
-  // slope is -1 in theory and measured -1.005; on spheres-plane-square -1.445.) The criterion is
-  // the issue's: lines at least as steep as -1, points near -0.72.
+  // slope is -1 in theory and measured -1.005; on spheres-plane-square -1.445.) The criterion:
+  // lines at least as steep as -1, points near -0.72.
   {
     Stopwatch clock;
     const std::string experiment = "grid-planes shadow points: std. deviation slope, stratified";
@@ -662,8 +662,8 @@ void add_line_rows(const ReproductionOptions& options, ReproductionReport& repor
 
   // Salesin & Jarosz Fig. 7: variance slopes of MIS(bsdf, lines) without and with smoothing, at
   // an unoccluded and a partly occluded point of glossy-strips (the paper's pixels lie on glossy
-  // receivers, where BSDF samples matter). N = 4^k so every cmj grid is square. The criterion is
-  // the issue's: with smoothing at least 0.4 steeper unoccluded, steeper when partly occluded.
+  // receivers, where BSDF samples matter). N = 4^k so every cmj grid is square. The criterion:
+  // with smoothing at least 0.4 steeper unoccluded, steeper when partly occluded.
   // (On quad-over-floor's diffuse floor, smoothing does not steepen the unoccluded slope:
   // balance -1.36, smooth -1.32 in quick mode.)
   {

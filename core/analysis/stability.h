@@ -1,5 +1,5 @@
 #pragma once
-// Numerical stability where methods fail (issue #8): every method against every adversarial
+// Numerical stability where methods fail: every method against every adversarial
 // configuration -- shading points on and near the light's plane, light edges parallel to the
 // normal, 1 cm and 1 mm lights at 40 m, a huge light at 1e-3, zero-area and edge-on occluder
 // triangles, an occluder whose edge lies in the shadow triangles of line samples, a phong

@@ -1,5 +1,5 @@
 #pragma once
-// The report of an equal-time comparison batch (issue #7): a table (table.csv, table.json),
+// The report of an equal-time comparison batch: a table (table.csv, table.json),
 // charts (PLplot, SVG and PNG), a paper-style figure (figure.png, Salesin & Jarosz Figs. 1, 8-10)
 // and a self-contained report.html holding all of it, written from a batch result folder
 // (core/report/batch_result.h). Every number is recomputed from the EXRs with core/image/metrics.h
