@@ -1,7 +1,7 @@
 #pragma once
 // The coordinator's core: jobs, tasks, leases, workers, persistence and job assembly, as one
-// thread-safe class with no gRPC in sight. The gRPC services (server/jobs_service.h,
-// server/workers_service.h) translate calls to it; errors are FarmError (server/farm_error.h).
+// thread-safe class with no gRPC in sight. The gRPC services (server/services.h)
+// translate calls to it; errors are FarmError (server/farm_error.h).
 // Requests and results use the protobuf messages of penumbra/v1/farm.proto as plain data.
 //
 // Jobs: the image is cut into tiles (default 64x64); a task is a tile and a pass block (default
