@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <iterator>
 #include <random>
 #include <tuple>
@@ -92,6 +93,16 @@ struct Coordinator::Job {
   // A store write of sealing or finishing failed (e.g. the data disk is full): memory was left
   // as it was before, and the expiry thread tries again.
   bool store_retry = false;
+  // This job's work per worker id since this coordinator started (job_workers): results
+  // accepted, their compute seconds, the first lease and the completions of the last rate
+  // window.
+  struct WorkerTally {
+    uint64_t tasks_completed = 0;
+    double compute_seconds = 0;
+    SteadyTime first_lease;
+    std::deque<SteadyTime> recent;
+  };
+  std::map<std::string, WorkerTally> by_worker;
 
   const v1::JobSpec& spec() const { return stored.spec(); }
   bool seconds_budget() const { return spec().budget_case() == v1::JobSpec::kComputeSeconds; }
@@ -1119,6 +1130,8 @@ v1::LeaseTasksResponse Coordinator::lease_tasks(const v1::LeaseTasksRequest& req
       task->set_task_index(next->task_index);
       task->set_attempt_token(leases_.grant(*next, request.worker_id(), now));
       ++counters_.tasks_leased;
+      if (auto [tally, added] = job.by_worker.try_emplace(request.worker_id()); added)
+        tally->second.first_lease = now;
       task->set_scene_hash(job.spec().scene_hash());
       task->set_method(job.spec().method());
       task->set_sampler(job.spec().sampler());
@@ -1192,6 +1205,15 @@ bool Coordinator::complete_task(const v1::CompleteTaskRequest& request) {
       worker->second.last_contact = std::chrono::steady_clock::now();
       // Delivering a result is contact for as long as the durable write takes.
       ++worker->second.calls_in_flight;
+    }
+    {
+      Job::WorkerTally& tally = job.by_worker[request.worker_id()];
+      ++tally.tasks_completed;
+      tally.compute_seconds += request.compute_seconds();
+      const SteadyTime now = std::chrono::steady_clock::now();
+      tally.recent.push_back(now);
+      while (now - tally.recent.front() > std::chrono::seconds(kJobWorkerRateWindowSeconds))
+        tally.recent.pop_front();
     }
     job.record.compute_seconds += request.compute_seconds();
     ++job.tasks_completed_ever;
@@ -1375,6 +1397,58 @@ std::vector<v1::WorkerInfo> Coordinator::workers() {
     result.push_back(info);
   }
   return result;
+}
+
+std::vector<JobWorkerActivity> Coordinator::job_workers(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  const Job& job = job_locked(job_id);
+  const auto now = std::chrono::steady_clock::now();
+  const auto window = std::chrono::seconds(kJobWorkerRateWindowSeconds);
+  std::map<std::string, size_t> leased = leases_.counts_for_job(job.record.id);
+  std::vector<JobWorkerActivity> result;
+  for (const auto& [id, tally] : job.by_worker) {
+    JobWorkerActivity activity;
+    activity.worker_id = id;
+    if (auto worker = workers_.find(id); worker != workers_.end()) {
+      activity.registered = true;
+      activity.name = worker->second.name;
+      activity.threads = worker->second.threads;
+      activity.alive = !worker->second.dead && now - worker->second.last_contact <= dead_after();
+    }
+    if (auto count = leased.find(id); count != leased.end())
+      activity.tasks_leased = uint32_t(count->second);
+    activity.tasks_completed = tally.tasks_completed;
+    activity.compute_seconds = tally.compute_seconds;
+    const auto recent = std::count_if(tally.recent.begin(), tally.recent.end(),
+                                      [&](SteadyTime at) { return now - at <= window; });
+    const double seconds =
+        std::clamp(std::chrono::duration<double>(now - tally.first_lease).count(), 1.0,
+                   double(window.count()));
+    activity.recent_tasks_per_second = double(recent) / seconds;
+    result.push_back(std::move(activity));
+  }
+  return result;
+}
+
+std::optional<std::string> Coordinator::reference_exr(const std::string& job_id) {
+  uint64_t reference_id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    const Job& job = job_locked(job_id);
+    if (job.spec().reference_case() == v1::JobSpec::kReferenceExr)
+      return job.spec().reference_exr();
+    if (job.spec().reference_case() != v1::JobSpec::kReferenceJob) return std::nullopt;
+    reference_id = parse_job_id(job.spec().reference_job());
+    auto it = jobs_.find(reference_id);
+    if (it == jobs_.end() || it->second->record.state != v1::JOB_STATE_DONE) return std::nullopt;
+  }
+  return store_.result(reference_id);
+}
+
+std::map<std::string, Region> Coordinator::regions(const std::string& job_id) {
+  std::lock_guard lock(mutex_);
+  const Job& job = job_locked(job_id);
+  return job.scene ? job.scene->regions : std::map<std::string, Region>{};
 }
 
 }  // namespace penumbra::farm

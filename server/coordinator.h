@@ -39,6 +39,7 @@
 #include "penumbra/v1/farm.pb.h"
 #include "server/call_context.h"
 #include "server/farm_error.h"
+#include "server/job_workers.h"
 #include "server/lease_table.h"
 #include "server/scene_transfer.h"
 #include "server/scheduler.h"
@@ -146,6 +147,15 @@ class Coordinator {
   // returned in `passes`.
   Film preview_film(const std::string& job_id, uint32_t* passes = nullptr);
   std::vector<v1::WorkerInfo> workers();
+  // The workers that rendered or hold this job's tasks since this coordinator started, by id
+  // (server/job_workers.h); the others do not appear.
+  std::vector<JobWorkerActivity> job_workers(const std::string& job_id);
+  // The job's reference EXR: the uploaded one, or the reference job's result once that job is
+  // done; empty without a reference (or before the reference job is done).
+  std::optional<std::string> reference_exr(const std::string& job_id);
+  // The regions of the job's scene; empty when its scene is not loaded (a job that had ended
+  // before this coordinator started).
+  std::map<std::string, Region> regions(const std::string& job_id);
   CoordinatorCounters counters() const;
 
   // Calls `on_change` (from any thread, never under the coordinator's lock) whenever the job's

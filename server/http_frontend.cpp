@@ -284,6 +284,62 @@ std::string batch_viewer_html(Coordinator& coordinator, BatchManager& batches,
   return comparison_viewer_html(content);
 }
 
+// The comparison viewer of one job: its image (the result when it has one, else the sealed passes
+// so far) and its reference when it has one, with the regions of its scene. Empty with a note
+// when there is nothing to show.
+std::string job_viewer_html(Coordinator& coordinator, const v1::JobStatus& status,
+                            std::string& note) {
+  if (status.state() == v1::JOB_STATE_FAILED) {
+    note = "No viewer: the job failed.";
+    return "";
+  }
+  if (status.passes_complete() == 0) {
+    note = "No viewer yet: no pass is complete.";
+    return "";
+  }
+  uint32_t passes = 0;
+  Film film = coordinator.preview_film(status.job_id(), &passes);
+  ComparisonViewerContent content;
+  content.width = film.color.width;
+  content.height = film.color.height;
+  const std::map<std::string, Region> regions = coordinator.regions(status.job_id());
+  for (const auto& [name, rect] : regions) content.regions.push_back({name, rect});
+  Image reference, reference_variance;
+  if (std::optional<std::string> exr = coordinator.reference_exr(status.job_id())) {
+    ImageMetadata metadata;
+    reference = decode_exr(*exr, &metadata, &reference_variance);
+    if (reference.width == content.width && reference.height == content.height) {
+      content.reference.label = "reference";
+      content.reference.method = metadata["penumbra:method"];
+      content.reference.sampler = metadata["penumbra:sampler"];
+      try {
+        content.reference.spp = uint32_t(std::stoul(metadata["penumbra:spp"]));
+      } catch (const std::exception&) {
+        content.reference.spp = 0;  // an uploaded EXR of another renderer
+      }
+      content.reference.image = &reference;
+      if (reference_variance.width == content.width)
+        content.reference.variance = &reference_variance;
+    }
+  }
+  ViewerImage image;
+  image.label = status.method();
+  image.method = status.method();
+  image.sampler = status.sampler();
+  image.spp = passes;
+  image.compute_seconds = status.compute_seconds();
+  image.image = &film.color;
+  image.variance = film.variance.width == content.width ? &film.variance : nullptr;
+  if (content.reference.image)
+    for (const auto& [region, summary] : error_summary(film.color, reference, regions))
+      image.mrse[region] = summary.mrse;
+  content.methods.push_back(std::move(image));
+  // The scales as the static report chooses them (core/report/comparison_viewer.h).
+  choose_viewer_scales(content);
+  note.clear();
+  return comparison_viewer_html(content);
+}
+
 }  // namespace
 
 HttpAddress parse_http_address(const std::string& text) {
@@ -313,7 +369,6 @@ HttpAddress parse_http_address(const std::string& text) {
 void FarmMonitor::sample() {
   std::vector<v1::JobStatus> jobs = coordinator_.list();
   CoordinatorCounters counters = coordinator_.counters();
-  std::vector<v1::WorkerInfo> workers = coordinator_.workers();
   auto now = std::chrono::steady_clock::now();
   int64_t now_ms = unix_milliseconds_now();
   std::lock_guard lock(mutex_);
@@ -333,15 +388,6 @@ void FarmMonitor::sample() {
   // Keep one sample older than the longest window so a full minute is always covered.
   while (completions_.size() > 2 && now - completions_[1].first > std::chrono::seconds(61))
     completions_.pop_front();
-  std::set<std::string> known;
-  for (const v1::WorkerInfo& worker : workers) {
-    known.insert(worker.worker_id());
-    auto& samples = worker_completions_[worker.worker_id()];
-    samples.emplace_back(now, worker.tasks_completed());
-    while (samples.size() > 2 && now - samples[1].first > std::chrono::seconds(61))
-      samples.pop_front();
-  }
-  std::erase_if(worker_completions_, [&](const auto& entry) { return !known.count(entry.first); });
 }
 
 namespace {
@@ -364,13 +410,6 @@ double rate_over(
 }
 
 }  // namespace
-
-std::map<std::string, double> FarmMonitor::worker_rates(std::chrono::seconds window) {
-  std::lock_guard lock(mutex_);
-  std::map<std::string, double> rates;
-  for (const auto& [id, samples] : worker_completions_) rates[id] = rate_over(samples, window);
-  return rates;
-}
 
 double FarmMonitor::completion_rate(std::chrono::seconds window) {
   std::lock_guard lock(mutex_);
@@ -677,17 +716,19 @@ void HttpFrontend::route() {
         [&] {
           v1::JobStatus status =
               coordinator_.status(authorization.caller, request.matches[1], true);
-          std::map<std::string, double> rates = monitor_.worker_rates();
-          std::vector<JobPageWorker> workers;
-          for (v1::WorkerInfo& info : coordinator_.workers()) {
-            JobPageWorker worker;
-            worker.recent_tasks_per_second =
-                rates.count(info.worker_id()) ? rates[info.worker_id()] : 0;
-            worker.info = std::move(info);
-            workers.push_back(std::move(worker));
-          }
+          // A running job's page refreshes itself, which would reset the viewer: it has the
+          // viewer only when asked (?viewer=1), and offers it otherwise.
+          JobPageViewer viewer;
+          if (is_terminal(status.state()) || request.get_param_value("viewer") == "1")
+            viewer.html = job_viewer_html(coordinator_, status, viewer.note);
+          else if (status.passes_complete() > 0)
+            viewer.offer = true;
+          else
+            viewer.note = "No viewer yet: no pass is complete.";
           response.set_header("Cache-Control", "no-store");
-          response.set_content(job_page_html(status, query, workers), "text/html; charset=utf-8");
+          response.set_content(
+              job_page_html(status, query, coordinator_.job_workers(status.job_id()), viewer),
+              "text/html; charset=utf-8");
         },
         query);
   });

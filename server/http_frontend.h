@@ -12,7 +12,9 @@
 //   GET /api/jobs/<id>/preview.png     the job's image so far, tone-mapped (?exposure=x)
 //   GET /api/workers                   the workers the coordinator knows
 //   GET /jobs/<id>                     a job's page: state, progress, preview, tasks by state,
-//                                      workers and their throughput, convergence charts, errors
+//                                      this job's workers and their throughput on it,
+//                                      convergence charts, errors, the comparison viewer of its
+//                                      image and reference (a running job's: ?viewer=1)
 //   GET /batches/<id>                  a batch's page: progress, runs, refusals, the comparison
 //                                      viewer of its images (server/status_pages.h)
 //
@@ -84,9 +86,6 @@ class FarmMonitor {
   std::string metrics_text();
   // Tasks completed per second over the last `window` (shorter while the monitor is younger).
   double completion_rate(std::chrono::seconds window = std::chrono::seconds(60));
-  // The same per worker (worker id to tasks per second), from the workers' completion counts.
-  std::map<std::string, double> worker_rates(
-      std::chrono::seconds window = std::chrono::seconds(60));
 
  private:
   struct Latencies {
@@ -102,8 +101,6 @@ class FarmMonitor {
   std::set<std::string> finished_jobs_;
   Latencies latencies_;
   std::deque<std::pair<std::chrono::steady_clock::time_point, uint64_t>> completions_;
-  std::map<std::string, std::deque<std::pair<std::chrono::steady_clock::time_point, uint64_t>>>
-      worker_completions_;  // by worker id, workers the coordinator still knows
 };
 
 struct HttpFrontendOptions {

@@ -90,4 +90,11 @@ size_t LeaseTable::count_for_job(uint64_t job_id) const {
   return count;
 }
 
+std::map<std::string, size_t> LeaseTable::counts_for_job(uint64_t job_id) const {
+  std::map<std::string, size_t> counts;
+  for (const auto& [token, lease] : leases_)
+    if (lease.task.job_id == job_id) ++counts[lease.worker_id];
+  return counts;
+}
+
 }  // namespace penumbra::farm

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
@@ -44,6 +45,8 @@ class LeaseTable {
   std::vector<Lease> release_worker(const std::string& worker_id);
   size_t count_for_worker(const std::string& worker_id) const;
   size_t count_for_job(uint64_t job_id) const;
+  // The leases of a job per worker id (workers that hold none are absent).
+  std::map<std::string, size_t> counts_for_job(uint64_t job_id) const;
   size_t size() const { return leases_.size(); }
 
  private:

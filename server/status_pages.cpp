@@ -130,14 +130,26 @@ std::vector<ChartSpec> job_convergence_charts(const v1::JobStatus& status) {
 }
 
 std::string job_page_html(const v1::JobStatus& status, const std::string& link_query,
-                          const std::vector<JobPageWorker>& workers) {
+                          const std::vector<JobWorkerActivity>& workers,
+                          const JobPageViewer& viewer) {
   const std::string q = html_escape(link_query);
+  // This page with the viewer (?viewer=1 after the token, if any).
+  const std::string with_viewer =
+      "/jobs/" + html_escape(status.job_id()) + (q.empty() ? "?" : q + "&amp;") + "viewer=1";
   std::ostringstream out;
   const std::string title =
       "Job " + status.job_id() + (status.name().empty() ? "" : ": " + status.name());
-  out << head(title, !finished(status.state())) << "<h1>" << html_escape(title) << "</h1>\n"
+  // A refresh would reset the viewer (its zoom and exposure): a running job's page with the
+  // viewer links to its newer state instead.
+  const bool running = !finished(status.state());
+  out << head(title, running && viewer.html.empty()) << "<h1>" << html_escape(title) << "</h1>\n"
       << "<p class=\"note\"><a href=\"/" << q << "\">dashboard</a> · <a href=\"/api/jobs/"
-      << html_escape(status.job_id()) << q << "\">JSON</a></p>\n";
+      << html_escape(status.job_id()) << q << "\">JSON</a>";
+  if (running && !viewer.html.empty())
+    out << " · <span id=\"stale\">running: this page shows the image at "
+        << status.passes_complete() << " spp; <a href=\"" << with_viewer
+        << "\">reload</a> for the newer passes</span>";
+  out << "</p>\n";
   out << "<table id=\"job\" data-state=\"" << farm::state_name(status.state())
       << "\" data-passes=\"" << status.passes_complete() << "\">\n";
   row(out, "state", "<b>" + farm::state_name(status.state()) + "</b>");
@@ -196,22 +208,23 @@ std::string job_page_html(const v1::JobStatus& status, const std::string& link_q
 
   out << "<h2>Workers</h2>\n";
   if (workers.empty()) {
-    out << "<p class=\"note\">No worker has registered.</p>\n";
+    out << "<p class=\"note\">No worker has leased a task of this job.</p>\n";
   } else {
-    out << "<p class=\"note\">Every worker the coordinator knows: the tasks it renders now and "
-           "its throughput over the last minute (of any job; this job holds "
-        << leased << " of the tasks leased).</p>\n"
+    out << "<p class=\"note\">The workers that rendered or hold this job's tasks, since the "
+           "coordinator started: this job's tasks each holds now and completed, their compute "
+           "seconds, and its rate on this job over the last "
+        << kJobWorkerRateWindowSeconds << " s.</p>\n"
         << "<table id=\"workers\">\n<tr><th class=\"text\">worker</th><th "
            "class=\"text\">state</th><th>threads</th><th>tasks now</th><th>recent "
            "tasks/s</th><th>tasks done</th><th>compute s</th></tr>\n";
-    for (const JobPageWorker& worker : workers) {
-      const v1::WorkerInfo& info = worker.info;
-      out << "<tr data-worker=\"" << html_escape(info.worker_id()) << "\"><td class=\"text\">"
-          << html_escape(info.name().empty() ? info.worker_id() : info.name())
-          << "</td><td class=\"text\">" << (info.alive() ? "alive" : "lost") << "</td><td>"
-          << info.threads() << "</td><td>" << info.tasks_leased() << "</td><td>"
-          << number(worker.recent_tasks_per_second, "%.3g") << "</td><td>" << info.tasks_completed()
-          << "</td><td>" << number(info.compute_seconds(), "%.1f") << "</td></tr>\n";
+    for (const JobWorkerActivity& worker : workers) {
+      const char* state = !worker.registered ? "forgotten" : worker.alive ? "alive" : "lost";
+      out << "<tr data-worker=\"" << html_escape(worker.worker_id) << "\"><td class=\"text\">"
+          << html_escape(worker.name.empty() ? worker.worker_id : worker.name)
+          << "</td><td class=\"text\">" << state << "</td><td>" << worker.threads << "</td><td>"
+          << worker.tasks_leased << "</td><td>" << number(worker.recent_tasks_per_second, "%.3g")
+          << "</td><td>" << worker.tasks_completed << "</td><td>"
+          << number(worker.compute_seconds, "%.1f") << "</td></tr>\n";
     }
     out << "</table>\n";
   }
@@ -255,6 +268,14 @@ std::string job_page_html(const v1::JobStatus& status, const std::string& link_q
           << number(error.rmse()) << "</td></tr>\n";
     out << "</table>\n";
   }
+  if (!viewer.html.empty())
+    out << viewer.html;
+  else if (viewer.offer)
+    out << "<h2>Viewer</h2>\n<p class=\"note\"><a id=\"open-viewer\" href=\"" << with_viewer
+        << "\">Open the comparison viewer</a> of the image so far (" << status.passes_complete()
+        << " spp); that page does not refresh itself.</p>\n";
+  else if (!viewer.note.empty())
+    out << "<h2>Viewer</h2>\n<p class=\"note\">" << html_escape(viewer.note) << "</p>\n";
   out << "</body>\n</html>\n";
   return out.str();
 }

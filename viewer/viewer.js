@@ -1,5 +1,8 @@
-// Penumbra's comparison viewer, embedded in every batch report (core/report/comparison_viewer.h
-// writes the data it reads and says how the pixels are encoded).
+// Penumbra's comparison viewer, embedded in every batch report and in the coordinator's batch and
+// job pages (core/report/comparison_viewer.h writes the data it reads and says how the pixels are
+// encoded). Without a reference (a farm job without one: data.reference is null) it shows the
+// methods alone: no flip, split, error or difference view, and each image's variance relative
+// to its own values.
 //
 // It reads the JSON in #viewer-data, decodes each image (RGBE planes, zlib, decoded by the
 // browser's DecompressionStream) and draws the one shown on a canvas: the method chosen by key or
@@ -18,9 +21,13 @@
   var data = JSON.parse(dataElement.textContent);
   var W = data.width, H = data.height, N = W * H;
   var reference = data.reference;
+  var hasReference = reference !== null && reference !== undefined;
   var methods = data.methods;
-  // Every image: the reference first, then the methods (key k shows methods[k - 1]).
-  var images = [reference].concat(methods);
+  // Every image: the reference first (when there is one), then the methods (key k shows
+  // methods[k - 1], images[k - 1 + base]).
+  var base = hasReference ? 1 : 0;
+  var images = hasReference ? [reference].concat(methods) : methods.slice();
+  function isReference(index) { return hasReference && index === 0; }
   var regions = [{name: 'image', rect: [0, 0, W, H]}].concat(data.regions);
   var regionColours = ['#ff8c00', '#00ccff', '#ff33cc', '#ffff33', '#4dff4d', '#ff4d4d'];
   var MAIN_W = 768, MAIN_H = Math.max(240, Math.min(640, Math.round(MAIN_W * H / W)));
@@ -29,7 +36,7 @@
 
   var state = {
     method: methods.length ? 0 : -1,  // index into methods
-    showReference: methods.length === 0,
+    showReference: hasReference && methods.length === 0,
     view: 'image',  // 'image', 'error' (relative error), 'difference' (signed), 'variance'
     stops: 0,       // exposure relative to data.exposure, in stops
     zoom: 1, cx: W / 2, cy: H / 2,
@@ -111,7 +118,7 @@
   // A pixel's relative variance: mean over channels of variance / (ref^2 + epsilon), its expected
   // term of the MRSE from noise alone.
   function relativeVariance(image, p) {
-    var v = image.varianceRgb, r = reference.rgb, sum = 0;
+    var v = image.varianceRgb, r = (hasReference ? reference : image).rgb, sum = 0;
     for (var c = 0; c < 3; ++c) sum += v[3 * p + c] / (r[3 * p + c] * r[3 * p + c] + data.mrse_epsilon);
     return sum / 3;
   }
@@ -191,7 +198,7 @@
   var methodButtons = bar.appendChild(el('div', {'class': 'pv-group'}));
   var buttons = [];
   images.forEach(function (image, index) {
-    var key = index === 0 ? 'R' : index <= 9 ? String(index) : '';
+    var key = isReference(index) ? 'R' : index - base < 9 ? String(index - base + 1) : '';
     var button = el('button', {type: 'button', 'data-index': index, title: image.method + ', ' + image.spp + ' spp'});
     button.appendChild(el('kbd', {}, key));
     button.appendChild(document.createTextNode(' ' + image.label));
@@ -203,6 +210,7 @@
   var viewButtons = {};
   [['image', 'I', 'image'], ['error', 'E', 'relative error'], ['difference', 'D', 'difference'],
    ['variance', 'V', 'variance']].forEach(function (v) {
+    if (!hasReference && (v[0] === 'error' || v[0] === 'difference')) return;
     var button = el('button', {type: 'button', 'data-view': v[0]});
     button.appendChild(el('kbd', {}, v[1]));
     button.appendChild(document.createTextNode(' ' + v[2]));
@@ -218,7 +226,8 @@
     button.addEventListener('click', action);
     return toggles.appendChild(button);
   }
-  var splitButton = toggle('S', 'split', function () { state.split = !state.split; update(); });
+  var splitButton = toggle('S', 'split', function () { state.split = hasReference && !state.split; update(); });
+  if (!hasReference) splitButton.style.display = 'none';
   var outlineButton = toggle('O', 'regions', function () { state.outlines = !state.outlines; update(); });
   toggle('F', 'fit', function () { fit(); update(); });
   var exposureLabel = bar.appendChild(el('label', {'class': 'pv-exposure'}, 'exposure '));
@@ -255,18 +264,22 @@
     figure.addEventListener('click', function () { show(index); });
     return crop;
   });
-  root.appendChild(el('p', {'class': 'note pv-help'},
-      'Keys: 1–9 a method, R or 0 the reference, Space flips between the method and the reference, ' +
-      'I image, E relative error |x − ref| / (ref + ' + data.relative_error_offset + '), D signed difference, ' +
-      'V variance (of the mean, from the EXR\'s variance layer, relative: σ² / (ref² + ' + data.mrse_epsilon + ')), ' +
-      '[ and ] exposure ∓½ stop, + and − zoom (or the wheel), arrows pan (or drag), F fit, S split ' +
-      '(drag the divider), O region outlines. Hover a pixel for every image\'s value. The crops below ' +
-      'show every image at the same view; click one to show it.'));
+  root.appendChild(el('p', {'class': 'note pv-help'}, hasReference
+      ? 'Keys: 1–9 a method, R or 0 the reference, Space flips between the method and the reference, ' +
+        'I image, E relative error |x − ref| / (ref + ' + data.relative_error_offset + '), D signed difference, ' +
+        'V variance (of the mean, from the EXR\'s variance layer, relative: σ² / (ref² + ' + data.mrse_epsilon + ')), ' +
+        '[ and ] exposure ∓½ stop, + and − zoom (or the wheel), arrows pan (or drag), F fit, S split ' +
+        '(drag the divider), O region outlines. Hover a pixel for every image\'s value. The crops below ' +
+        'show every image at the same view; click one to show it.'
+      : 'No reference: no error views. Keys: 1–9 an image, I image, V variance (of the mean, from the ' +
+        'EXR\'s variance layer, relative to the image itself: σ² / (x² + ' + data.mrse_epsilon + ')), ' +
+        '[ and ] exposure ∓½ stop, + and − zoom (or the wheel), arrows pan (or drag), F fit, ' +
+        'O region outlines. Hover a pixel for its value.'));
 
   // ---- state changes ----
-  function shownIndex() { return state.showReference || state.method < 0 ? 0 : state.method + 1; }
+  function shownIndex() { return (hasReference && state.showReference) || state.method < 0 ? 0 : state.method + base; }
   function show(index) {
-    if (index === 0) { state.showReference = true; } else { state.method = index - 1; state.showReference = false; }
+    if (isReference(index)) { state.showReference = true; } else { state.method = index - base; state.showReference = false; }
     update();
   }
   function setView(view) { state.view = view; update(); }
@@ -334,7 +347,7 @@
     context.fillStyle = '#333';
     context.fillRect(0, 0, width, height);
     var index = shownIndex();
-    if (state.split && index !== 0) {
+    if (state.split && hasReference && index !== 0) {
       var at = Math.round(state.splitAt * width);
       context.save(); context.beginPath(); context.rect(0, 0, at, height); context.clip();
       drawView(context, width, height, 1, index); context.restore();
@@ -378,7 +391,8 @@
   function probeRows() {
     probeTable.textContent = '';
     if (!state.probe) { probeTable.appendChild(el('tr')).appendChild(el('td', {'class': 'text'}, 'Hover the image to probe a pixel.')); return; }
-    var x = state.probe[0], y = state.probe[1], i = 3 * (y * W + x), r = reference.rgb, offset = data.relative_error_offset;
+    var x = state.probe[0], y = state.probe[1], i = 3 * (y * W + x), r = hasReference ? reference.rgb : null;
+    var offset = data.relative_error_offset;
     var head = probeTable.appendChild(el('tr'));
     ['pixel ' + x + ', ' + y, 'R', 'G', 'B', 'rel. error', 'rel. variance'].forEach(function (t) { head.appendChild(el('th', {}, t)); });
     images.forEach(function (image, index) {
@@ -388,9 +402,9 @@
       var sum = 0;
       for (var c = 0; c < 3; ++c) {
         row.appendChild(el('td', {}, fmt(image.rgb[i + c])));
-        sum += Math.abs(image.rgb[i + c] - r[i + c]) / (Math.abs(r[i + c]) + offset);
+        if (r) sum += Math.abs(image.rgb[i + c] - r[i + c]) / (Math.abs(r[i + c]) + offset);
       }
-      row.appendChild(el('td', {}, index === 0 ? '–' : fmt(sum / 3)));
+      row.appendChild(el('td', {}, !r || index === 0 ? '–' : fmt(sum / 3)));
       row.appendChild(el('td', {}, image.varianceRgb ? fmt(relativeVariance(image, y * W + x)) : '–'));
     });
   }
@@ -406,9 +420,11 @@
       var band = scaleBar.appendChild(el('span', {'class': 'pv-gradient'}));
       band.style.background = 'linear-gradient(to right, #440154, #3b528b, #21918c, #5ec962, #fde725)';
       scaleBar.appendChild(el('span', {}, '≥ ' + fmt(data.variance_scale[1])));
-      scaleBar.appendChild(el('span', {'class': 'note'},
-          ' variance of the mean / (ref² + ' + data.mrse_epsilon + '), mean over channels, log scale: ' +
-          'the pixel\'s expected MRSE term from noise'));
+      scaleBar.appendChild(el('span', {'class': 'note'}, hasReference
+          ? ' variance of the mean / (ref² + ' + data.mrse_epsilon + '), mean over channels, log scale: ' +
+            'the pixel\'s expected MRSE term from noise'
+          : ' variance of the mean / (x² + ' + data.mrse_epsilon + '), x the image itself, mean over ' +
+            'channels, log scale'));
       return;
     }
     var gradient = state.view === 'error'
@@ -434,14 +450,14 @@
     title.textContent = '';
     title.appendChild(el('b', {}, image.label));
     title.appendChild(document.createTextNode(' ' + image.method + ', ' + image.sampler + ', ' + image.spp + ' spp' +
-        (index === 0 ? ' (reference)' : ', repeat ' + image.repeat + ', ' + fmt(image.compute_seconds) + ' s')));
+        (isReference(index) ? ' (reference)' : ', repeat ' + image.repeat + ', ' + fmt(image.compute_seconds) + ' s')));
     mrseRows(image);
     probeRows();
     scaleLegend();
     crops.querySelectorAll('figure').forEach(function (figure, i) {
       figure.classList.toggle('pv-on', i === index);
       var im = images[i], caption = figure.querySelector('figcaption'), corrected = im.corrected[state.region];
-      caption.textContent = im.label + (i === 0 ? '' : ': MRSE ' + state.region + ' ' +
+      caption.textContent = im.label + (isReference(i) || !hasReference ? '' : ': MRSE ' + state.region + ' ' +
           (corrected ? intervalText(corrected) : fmt(im.mrse[state.region])));
     });
     draw();
@@ -458,14 +474,14 @@
 
   // ---- input ----
   var KEYS = {
-    ' ': function () { if (state.method >= 0) state.showReference = !state.showReference; },
-    r: function () { state.showReference = true; }, '0': function () { state.showReference = true; },
-    i: function () { state.view = 'image'; }, e: function () { state.view = 'error'; },
-    d: function () { state.view = 'difference'; }, v: function () { state.view = 'variance'; },
+    ' ': function () { if (hasReference && state.method >= 0) state.showReference = !state.showReference; },
+    r: function () { state.showReference = hasReference; }, '0': function () { state.showReference = hasReference; },
+    i: function () { state.view = 'image'; }, e: function () { if (hasReference) state.view = 'error'; },
+    d: function () { if (hasReference) state.view = 'difference'; }, v: function () { state.view = 'variance'; },
     '[': function () { state.stops = Math.max(-10, state.stops - 0.5); },
     ']': function () { state.stops = Math.min(10, state.stops + 0.5); },
     '+': function () { zoomBy(2); }, '=': function () { zoomBy(2); }, '-': function () { zoomBy(0.5); },
-    f: fit, s: function () { state.split = !state.split; }, o: function () { state.outlines = !state.outlines; },
+    f: fit, s: function () { state.split = hasReference && !state.split; }, o: function () { state.outlines = !state.outlines; },
     ArrowLeft: function () { state.cx -= MAIN_W / 8 / state.zoom; clampView(); },
     ArrowRight: function () { state.cx += MAIN_W / 8 / state.zoom; clampView(); },
     ArrowUp: function () { state.cy -= MAIN_H / 8 / state.zoom; clampView(); },
@@ -541,7 +557,8 @@
     return;
   }
   Promise.all(images.map(decode)).then(function () {
-    status.textContent = W + '×' + H + ' pixels, ' + methods.length + ' method(s) and the reference; the values are ' +
+    status.textContent = W + '×' + H + ' pixels, ' + methods.length + ' method(s)' +
+        (hasReference ? ' and the reference' : ', no reference') + '; the values are ' +
         'the EXRs\' to within 0.4% of each pixel\'s brightest channel.';
     fit();
     root.setAttribute('data-ready', '1');

@@ -154,21 +154,25 @@ double choose_difference_scale(const std::vector<const Image*>& images, const Im
   return magnitudes[index] > 0 ? double(magnitudes[index]) : 1.0;
 }
 
-std::pair<double, double> choose_variance_scale(const std::vector<const Image*>& variances,
-                                                const Image& reference) {
-  std::vector<float> relative;
-  for (const Image* variance : variances) {
-    if (!variance) continue;
-    check_same_size(*variance, reference);
-    for (size_t i = 0; i + 2 < reference.rgb.size(); i += 3) {
-      double sum = 0;
-      for (size_t c = 0; c < 3; ++c) {
-        double r = reference.rgb[i + c];
-        sum += double(variance->rgb[i + c]) / (r * r + kMrseEpsilon);
-      }
-      if (std::isfinite(sum) && sum > 0) relative.push_back(float(sum / 3));
+namespace {
+
+// Appends the positive relative variances of `variance` against `denominator` (the mean over
+// channels of variance / (d^2 + kMrseEpsilon)) to `relative`.
+void add_relative_variances(const Image& variance, const Image& denominator,
+                            std::vector<float>& relative) {
+  check_same_size(variance, denominator);
+  for (size_t i = 0; i + 2 < denominator.rgb.size(); i += 3) {
+    double sum = 0;
+    for (size_t c = 0; c < 3; ++c) {
+      double r = denominator.rgb[i + c];
+      sum += double(variance.rgb[i + c]) / (r * r + kMrseEpsilon);
     }
+    if (std::isfinite(sum) && sum > 0) relative.push_back(float(sum / 3));
   }
+}
+
+// The decades around the 1st and 99th percentiles of `relative`; [1e-6, 1] when it is empty.
+std::pair<double, double> variance_scale_of(std::vector<float>& relative) {
   if (relative.empty()) return {1e-6, 1};
   auto at = [&](double fraction) {
     size_t index = std::min(relative.size() - 1, size_t(fraction * double(relative.size())));
@@ -181,9 +185,30 @@ std::pair<double, double> choose_variance_scale(const std::vector<const Image*>&
   return {low, high};
 }
 
+}  // namespace
+
+std::pair<double, double> choose_variance_scale(const std::vector<const Image*>& variances,
+                                                const Image& reference) {
+  std::vector<float> relative;
+  for (const Image* variance : variances)
+    if (variance) add_relative_variances(*variance, reference, relative);
+  return variance_scale_of(relative);
+}
+
 void choose_viewer_scales(ComparisonViewerContent& content) {
-  if (!content.reference.image)
-    throw std::invalid_argument("comparison viewer: reference: no image");
+  if (!content.reference.image) {
+    if (content.methods.empty() || !content.methods.front().image)
+      throw std::invalid_argument("comparison viewer: no reference and no method's image");
+    std::vector<float> relative;
+    for (const ViewerImage& method : content.methods)
+      if (method.image && method.variance)
+        add_relative_variances(*method.variance, *method.image, relative);
+    content.exposure = choose_exposure(*content.methods.front().image);
+    content.error_scale = 1;
+    content.difference_scale = 1;
+    std::tie(content.variance_low, content.variance_high) = variance_scale_of(relative);
+    return;
+  }
   const Image& reference = *content.reference.image;
   std::vector<const Image*> images, variances;
   for (const ViewerImage& method : content.methods) {
@@ -212,7 +237,12 @@ std::string comparison_viewer_html(const ComparisonViewerContent& content) {
     data["regions"].push_back(
         {{"name", region.name},
          {"rect", {region.rect.x0, region.rect.y0, region.rect.x1, region.rect.y1}}});
-  data["reference"] = image_json(content.reference, content.width, content.height);
+  if (content.reference.image)
+    data["reference"] = image_json(content.reference, content.width, content.height);
+  else if (content.methods.empty())
+    throw std::invalid_argument("comparison viewer: no reference and no method");
+  else
+    data["reference"] = nullptr;
   data["methods"] = nlohmann::json::array();
   for (const ViewerImage& method : content.methods)
     data["methods"].push_back(image_json(method, content.width, content.height));

@@ -74,6 +74,9 @@ struct ComparisonViewerContent {
   // variance: mean over channels of variance / (ref^2 + kMrseEpsilon), a pixel's expected term of
   // the MRSE from noise alone.
   double variance_low = 1e-6, variance_high = 1;
+  // The reference; its image may be null (a farm job without one): the viewer then shows the
+  // methods alone, without the error and difference views, and each image's variance relative
+  // to its own values (variance / (x^2 + kMrseEpsilon)).
   ViewerImage reference;
   std::vector<ViewerImage> methods;  // in batch order, refused methods left out
   std::vector<ViewerRegion> regions;
@@ -91,12 +94,14 @@ std::pair<double, double> choose_variance_scale(const std::vector<const Image*>&
 
 // Every scale of the content from its images, as the report's figure chooses them: the
 // exposure (choose_exposure of the reference), the relative error's (choose_error_scale), the
-// signed difference's and the variance view's.
+// signed difference's and the variance view's. Without a reference: the exposure of the first
+// method's image, the variance scale of each image relative to itself, the error scales 1.
 void choose_viewer_scales(ComparisonViewerContent& content);
 
 // The viewer's section of the page (a <section id="viewer"> with its <style>, the data as a
 // <script type="application/json"> and the viewer's <script>). Throws std::invalid_argument when
-// an image is missing or its size differs from width x height.
+// an image is missing (a method's; without a reference at least one method is needed) or its
+// size differs from width x height.
 std::string comparison_viewer_html(const ComparisonViewerContent& content);
 
 // The viewer's script and style as embedded in the build (viewer/viewer.js, viewer/viewer.css).

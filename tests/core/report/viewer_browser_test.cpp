@@ -4,7 +4,8 @@
 // what the canvas shows is read back and checked against the EXRs: the key flips the method,
 // zoom is nearest neighbour, the crops show the same pixel, the exposure and the error views
 // give the values computed here, the probe and the table's links work, and the page neither
-// logs errors nor makes a request. Screenshots at two zoom levels are written for people.
+// logs errors nor makes a request; the viewer without a reference (a farm job's) shows the image
+// and its variance alone. Screenshots at two zoom levels are written for people.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>
@@ -200,6 +201,23 @@ class Page {
 
   json call(const std::string& method, const json& params) {
     return browser_.call(method, params, session_);
+  }
+  const std::string& session() const { return session_; }
+
+  // Waits until the viewer of the page now loading has decoded its images (or failed).
+  void wait_for_viewer(Clock::time_point deadline) {
+    for (;;) {
+      try {
+        json state = eval(
+            "(function(){var v=document.getElementById('viewer');return !!v&&(v.hasAttribute("
+            "'data-ready')||v.hasAttribute('data-error'));})()");
+        if (state.is_boolean() && state.get<bool>()) return;
+      } catch (const std::runtime_error&) {
+        // The document was replaced while the expression ran: ask the new one.
+      }
+      if (Clock::now() > deadline) throw std::runtime_error("the viewer did not get ready");
+      usleep(20'000);
+    }
   }
 
   // The value of a JavaScript expression (promises awaited).
@@ -561,6 +579,69 @@ TEST(ViewerBrowser, FlipZoomExposureErrorViewsProbeAndLinks) {
     }
   }
   EXPECT_EQ(requests, 1);
+  // Without a reference (a farm job that has none), in a second tab of the same browser: the
+  // image alone, no flip, split, error or difference view, its variance relative to itself.
+  {
+    ComparisonViewerContent content;
+    content.width = kWidth;
+    content.height = kHeight;
+    content.regions.push_back({"middle", batch.region});
+    ViewerImage job;
+    job.label = "a-job";
+    job.method = "sa";
+    job.sampler = "stratified";
+    job.spp = 16;
+    job.image = &batch.methods[1];
+    job.variance = &batch.variances[1];
+    content.methods.push_back(job);
+    choose_viewer_scales(content);
+    EXPECT_DOUBLE_EQ(content.exposure, choose_exposure(batch.methods[1]));
+    std::ofstream(dir / "job.html")
+        << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"></head><body>\n"
+        << comparison_viewer_html(content) << "</body></html>\n";
+    Page job_page(browser);
+    const std::string job_url = "file://" + fs::absolute(dir / "job.html").string();
+    job_page.call("Page.navigate", {{"url", job_url}});
+    job_page.wait_for_viewer(start + std::chrono::seconds(20));
+    ASSERT_EQ(job_page.attribute("data-error"), "");
+    EXPECT_EQ(job_page.attribute("data-shown"), "a-job");
+    EXPECT_EQ(job_page.eval("document.querySelectorAll('#viewer [data-view]').length").get<int>(),
+              2);  // image and variance
+    job_page.key("e", "KeyE", 69);
+    job_page.key(" ", "Space", 32);
+    job_page.key("r", "KeyR", 82);
+    EXPECT_EQ(job_page.attribute("data-view"), "image");
+    EXPECT_EQ(job_page.attribute("data-shown"), "a-job");
+    expect_near(job_page.pixel(384, 288), tonemapped(batch.methods[1], 32, 24, content.exposure), 1,
+                "no reference, image");
+    job_page.key("v", "KeyV", 86);
+    EXPECT_EQ(job_page.attribute("data-view"), "variance");
+    const Image image = decode_viewer_image(encode_viewer_image(batch.methods[1]), kWidth, kHeight);
+    const Image variance =
+        decode_viewer_image(encode_viewer_image(batch.variances[1]), kWidth, kHeight);
+    double relative = 0;
+    for (int c = 0; c < 3; ++c) {
+      double x = image.at(32, 24)[c];
+      relative += variance.at(32, 24)[c] / (x * x + kMrseEpsilon);
+    }
+    relative /= 3;
+    const double low = content.variance_low, high = content.variance_high;
+    EXPECT_LT(low, high);
+    Rgb colour =
+        viridis((std::log10(relative) - std::log10(low)) / (std::log10(high) - std::log10(low)));
+    expect_near(job_page.pixel(384, 288),
+                {int(std::lround(255 * colour.x)), int(std::lround(255 * colour.y)),
+                 int(std::lround(255 * colour.z))},
+                1, "no reference, variance relative to the image");
+    for (const json& event : browser.events()) {
+      if (event.value("sessionId", "") != job_page.session()) continue;
+      const std::string method = event.value("method", "");
+      if (method == "Runtime.exceptionThrown") ADD_FAILURE() << event.dump();
+      if (method == "Runtime.consoleAPICalled" && event["params"].value("type", "") == "error")
+        ADD_FAILURE() << event.dump();
+    }
+  }
+
   // Attached to the test's output: GoogleTest's XML report (--gtest_output=xml) lists them as
   // properties, ctest's as ATTACHED_FILES (tests/CMakeLists.txt), and the log names them.
   RecordProperty("screenshot_fit", (dir / "viewer-fit.png").string());

@@ -1,7 +1,8 @@
 // The comparison viewer's variance view and scales: the variance scale spans the decades of the
 // relative variance's 1st and 99th percentiles, choose_viewer_scales gives the figure's and the
 // difference's scales, and the page's section carries each image's variance layer (decoding to
-// the layer within the encoding's bound), refusing a layer of the wrong size.
+// the layer within the encoding's bound), refusing a layer of the wrong size; without a reference
+// each image is its own scale.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,18 +22,25 @@ using testing::base64_decode;
 using testing::wide_range_image;
 using testing::worst_error;
 
+// An image of `count` x 1 pixels of 0.5 and a variance layer whose relative variances
+// var / (0.5^2 + 1e-6) run log-uniformly from 2e-5 to 3e-2.
+std::pair<Image, Image> log_uniform_relative_variances(int count) {
+  Image image(count, 1), variance(count, 1);
+  for (int x = 0; x < count; ++x) {
+    double relative = 2e-5 * std::pow(1.5e3, double(x) / (count - 1));
+    image.set(x, 0, {0.5, 0.5, 0.5});
+    double v = relative * (0.25 + kMrseEpsilon);
+    variance.set(x, 0, {v, v, v});
+  }
+  return {image, variance};
+}
+
 TEST(ViewerScales, VarianceScaleSpansTheDecadesOfThePercentiles) {
   // Relative variances var / (ref^2 + 1e-6) from 2e-5 to 3e-2, log-uniform over 200 pixels: the
   // 1st percentile (index 2) is above 2e-5, the 99th (index 198) below 3e-2, so the scale is the
   // decades around them, [1e-5, 1e-1].
   const int count = 200;
-  Image reference(count, 1), variance(count, 1);
-  for (int x = 0; x < count; ++x) {
-    double relative = 2e-5 * std::pow(1.5e3, double(x) / (count - 1));
-    reference.set(x, 0, {0.5, 0.5, 0.5});
-    double v = relative * (0.25 + kMrseEpsilon);
-    variance.set(x, 0, {v, v, v});
-  }
+  const auto [reference, variance] = log_uniform_relative_variances(count);
   const auto [low, high] = choose_variance_scale({&variance, nullptr}, reference);
   EXPECT_DOUBLE_EQ(low, 1e-5);
   EXPECT_DOUBLE_EQ(high, 1e-1);
@@ -92,6 +100,35 @@ TEST(ViewerScales, SectionCarriesVarianceLayersAndTheSharedScales) {
               std::string::npos)
         << error.what();
   }
+}
+
+TEST(ViewerScales, WithoutAReferenceEachImageIsItsOwnScale) {
+  // A farm job without a reference: the exposure of its image, the variance relative to the
+  // image itself (the same decades as against a reference of those values), null in the data.
+  const int count = 200;
+  const auto [image, variance] = log_uniform_relative_variances(count);
+  ComparisonViewerContent content;
+  content.width = count;
+  content.height = 1;
+  content.methods.push_back({"sa", "sa", "stratified", 16, 0, 1.5, &image, {}, {}, 0, &variance});
+  choose_viewer_scales(content);
+  EXPECT_EQ(content.exposure, choose_exposure(image));
+  EXPECT_EQ(content.error_scale, 1.0);
+  EXPECT_EQ(content.difference_scale, 1.0);
+  EXPECT_DOUBLE_EQ(content.variance_low, 1e-5);
+  EXPECT_DOUBLE_EQ(content.variance_high, 1e-1);
+  const std::string html = comparison_viewer_html(content);
+  const std::string open = R"(<script type="application/json" id="viewer-data">)";
+  ASSERT_NE(html.find(open), std::string::npos);
+  const size_t payload = html.find(open) + open.size();
+  nlohmann::json data =
+      nlohmann::json::parse(html.substr(payload, html.find("</script>", payload) - payload));
+  EXPECT_TRUE(data["reference"].is_null());
+  ASSERT_EQ(data["methods"].size(), 1u);
+  // Nothing at all to show is refused.
+  content.methods.clear();
+  EXPECT_THROW(choose_viewer_scales(content), std::invalid_argument);
+  EXPECT_THROW(comparison_viewer_html(content), std::invalid_argument);
 }
 
 }  // namespace
