@@ -5,8 +5,8 @@
 // one run.
 //
 // Two levels:
-// - samplers of directions (sa_*: Peters' solid angle sampling, core/polygon/solid_angle_polygon.h;
-//   sa_arvo_*: Arvo's original, core/polygon/arvo_solid_angle.h; psa_*), as in the paper;
+// - samplers of directions (sa_*: Peters' solid angle sampling, core/math/solid_angle_polygon.h;
+//   sa_arvo_*: Arvo's original, core/math/arvo_solid_angle.h; psa_*), as in the paper;
 // - the point strategies the estimator runs (strategy_<name>_*: area, sa, psa, ltc on a ggx
 //   material), which add the plane hit and the area-measure pdf: what a method pays.
 //
@@ -19,10 +19,10 @@
 #include <random>
 #include <vector>
 
+#include "core/math/arvo_solid_angle.h"
+#include "core/math/projected_solid_angle.h"
+#include "core/math/solid_angle_polygon.h"
 #include "core/math/vec.h"
-#include "core/polygon/arvo_solid_angle.h"
-#include "core/polygon/projected_solid_angle.h"
-#include "core/polygon/solid_angle_polygon.h"
 #include "core/strategies/area_strategy.h"
 #include "core/strategies/ltc_strategy.h"
 #include "core/strategies/psa_strategy.h"

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/math/projected_solid_angle.h"
 #include "core/method/direct_lighting.h"
 #include "core/method/method.h"
-#include "core/polygon/projected_solid_angle.h"
 #include "core/sampling/pattern.h"
 #include "core/scene/light_setup.h"
 

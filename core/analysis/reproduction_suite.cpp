@@ -17,7 +17,7 @@
 #include "core/analysis/variance_convergence.h"
 #include "core/analysis/visibility_reproduction.h"
 #include "core/image/metrics.h"
-#include "core/polygon/projected_solid_angle.h"
+#include "core/math/projected_solid_angle.h"
 #include "core/render/probe.h"
 #include "core/scene/scene.h"
 

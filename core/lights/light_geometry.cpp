@@ -13,24 +13,10 @@
 
 #include "core/lights/light_geometry.h"
 
+#include "core/sampling/pattern.h"
+
 namespace penumbra {
 namespace {
-
-// Shirley & Chiu 1997 concentric map from [0,1]^2 to the unit disk. A local copy:
-// penumbra_lights does not link penumbra_sampling (core/sampling/pattern.h has the shared one).
-Vec2 concentric_disk(const Vec2& u) {
-  double a = 2.0 * u.x - 1.0, b = 2.0 * u.y - 1.0;
-  if (a == 0 && b == 0) return {0, 0};
-  double r, phi;
-  if (std::abs(a) > std::abs(b)) {
-    r = a;
-    phi = (kPi / 4.0) * (b / a);
-  } else {
-    r = b;
-    phi = (kPi / 2.0) - (kPi / 4.0) * (a / b);
-  }
-  return {r * std::cos(phi), r * std::sin(phi)};
-}
 
 // (s, t) with point = origin + s edge1 + t edge2 (least squares for points off the plane).
 Vec2 quad_coordinates(const Light& light, const Vec3& point) {
@@ -157,7 +143,7 @@ Vec3 light_point_uniform(const Light& light, const Vec2& u) {
       return (1.0 - su) * v[0] + (su * (1.0 - u.y)) * v[chosen] + (su * u.y) * v[chosen + 1];
     }
     case LightType::Disk: {
-      Vec2 d = concentric_disk(u);
+      Vec2 d = square_to_disk_concentric(u);
       Frame frame = Frame::from_normal(light.normal);
       return light.center + light.radius * (d.x * frame.s + d.y * frame.t);
     }

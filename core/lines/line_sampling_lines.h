@@ -18,8 +18,6 @@
 
 namespace penumbra {
 
-struct ShadingPoint;
-
 // The edge the lines run along: `u` lines run along edge1, `v` lines along edge2.
 enum class LineAxis { Edge1, Edge2 };
 

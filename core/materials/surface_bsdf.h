@@ -1,8 +1,8 @@
 #pragma once
 // The BSDF of a pbrt-v3 material at one shading point: its lobes (pbrt-v3's BxDFs, PBR 3rd ed.
 // ch. 8) with every texture already evaluated, in the hit's shading frame. Built by
-// core/materials/pbrt_material.h; used through the shading point by every strategy
-// (core/strategies/strategy.h) and, for its delta lobes, by the specular chains of the renderer.
+// core/materials/pbrt_material.h; used through the shading point (core/lights/shading_point.h)
+// by every strategy and, for its delta lobes, by the specular chains of the renderer.
 //
 // Lobes (local frame: z = shading normal on the surface's outside, x = shading tangent s):
 //   lambert            R / pi

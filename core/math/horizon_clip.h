@@ -1,7 +1,7 @@
 #pragma once
 // The horizon clip of a polygon: the one implementation behind Lambert's formula
 // (core/math/lambert_polygon.h), the exact visible light (core/exact) and Peters' projected
-// solid angle (core/polygon/projected_solid_angle.h, in the local frame n = z).
+// solid angle (core/math/projected_solid_angle.h, in the local frame n = z).
 
 #include <cstddef>
 #include <span>

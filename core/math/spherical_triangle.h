@@ -1,8 +1,8 @@
 #pragma once
 // The solid angle of a spherical triangle: van Oosterom & Strackee 1983, a single atan2
 // (Peters 2021 Eq. 13). Sampling spherical triangles and polygons uniformly in solid angle lives
-// in core/polygon/solid_angle_polygon.h (Peters 2021 Sec. 5, the `sa` of polygons), Arvo's
-// original form in core/polygon/arvo_solid_angle.h (for comparison).
+// in core/math/solid_angle_polygon.h (Peters 2021 Sec. 5, the `sa` of polygons), Arvo's
+// original form in core/math/arvo_solid_angle.h (for comparison).
 //
 // Double precision: a 1 cm light at 40 m subtends 6e-8 sr; the triple product is formed from the
 // edge vectors b - a and c - a, which carry the triangle's size without the cancellation that

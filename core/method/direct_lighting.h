@@ -18,11 +18,11 @@
 
 #include <vector>
 
+#include "core/lights/shading_point.h"
 #include "core/method/method.h"
 #include "core/method/visibility.h"
 #include "core/sampling/pattern.h"
 #include "core/scene/scene.h"
-#include "core/strategies/strategy.h"
 
 namespace penumbra {
 

@@ -9,11 +9,11 @@
 // radiance (for a gaussian profile its peak: the c_j only steer weights, any value is unbiased).
 // These are also the classic LTC estimate of unshadowed shading (Heitz et al. 2016).
 
+#include "core/lights/shading_point.h"
 #include "core/method/combination.h"
 #include "core/scene/scene.h"
 #include "core/strategies/ltc_strategy.h"
 #include "core/strategies/psa_strategy.h"
-#include "core/strategies/strategy.h"
 
 namespace penumbra {
 

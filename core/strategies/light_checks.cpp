@@ -1,6 +1,6 @@
 #include "core/strategies/light_checks.h"
 
-#include "core/polygon/polygon_light.h"
+#include "core/lights/polygon_light.h"
 
 namespace penumbra {
 

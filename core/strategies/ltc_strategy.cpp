@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "core/materials/ggx.h"
-#include "core/polygon/ltc_ggx_table.h"
+#include "core/materials/ltc_ggx_table.h"
 
 namespace penumbra {
 

@@ -12,7 +12,7 @@
 // As Peters does, we clip only in the cosine space: a sample may fall below the shading point's
 // horizon (the integrand is 0 there); pdf() is consistent with that.
 //
-// Materials: `ggx` uses the fitted table (core/polygon/ltc_ggx_table.h, alpha = roughness clamped
+// Materials: `ggx` uses the fitted table (core/materials/ltc_ggx_table.h, alpha = roughness clamped
 // like the BSDF does, theta_o from wo and the normal). `lambert` uses the identity (a clamped
 // cosine): then ltc == psa. `phong` is not fitted: it also gets the identity (ltc == psa), an
 // unbiased but uninformed choice, and its lobe albedo is reported as 0 so that Peters' weighted
@@ -23,10 +23,10 @@
 #include <string>
 #include <string_view>
 
+#include "core/lights/polygon_light.h"
+#include "core/math/ltc_distribution.h"
+#include "core/math/projected_solid_angle.h"
 #include "core/math/vec.h"
-#include "core/polygon/ltc_distribution.h"
-#include "core/polygon/polygon_light.h"
-#include "core/polygon/projected_solid_angle.h"
 #include "core/scene/scene.h"
 #include "core/strategies/light_checks.h"
 #include "core/strategies/registry.h"

@@ -15,9 +15,9 @@
 #include <string>
 #include <string_view>
 
+#include "core/lights/polygon_light.h"
+#include "core/math/projected_solid_angle.h"
 #include "core/math/vec.h"
-#include "core/polygon/polygon_light.h"
-#include "core/polygon/projected_solid_angle.h"
 #include "core/scene/scene.h"
 #include "core/strategies/light_checks.h"
 #include "core/strategies/registry.h"

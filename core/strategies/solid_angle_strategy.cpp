@@ -1,8 +1,8 @@
 #include "core/strategies/solid_angle_strategy.h"
 
 #include "core/lights/light_geometry.h"
+#include "core/math/solid_angle_polygon.h"
 #include "core/math/spherical_triangle.h"
-#include "core/polygon/solid_angle_polygon.h"
 
 namespace penumbra {
 namespace {

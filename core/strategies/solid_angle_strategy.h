@@ -5,7 +5,7 @@
 // - Rectangular quads (edges perpendicular to 1e-6 relative): Ureña, Fajardo & King 2013
 //   (core/math/spherical_rectangle.h); u.x picks the line along edge2, u.y the point on it.
 // - Other parallelograms and polygons: Peters 2021 Sec. 5 (SolidAnglePolygonSampler,
-//   core/polygon/solid_angle_polygon.h): the triangle fan around vertex 0, a triangle chosen
+//   core/math/solid_angle_polygon.h): the triangle fan around vertex 0, a triangle chosen
 //   by its solid angle (van Oosterom & Strackee), then
 //   Peters' subtriangle construction of Arvo 1995's map; every fan triangle is prepared once per
 //   shading point (no heap allocation). Polygons of more than kMaxPolygonVertices (16) vertices
@@ -25,8 +25,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/math/solid_angle_polygon.h"
 #include "core/math/spherical_rectangle.h"
-#include "core/polygon/solid_angle_polygon.h"
 #include "core/strategies/registry.h"
 #include "core/strategies/strategy.h"
 

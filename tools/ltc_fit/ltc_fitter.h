@@ -19,8 +19,8 @@
 #include <span>
 #include <vector>
 
+#include "core/materials/ltc_ggx_table.h"
 #include "core/math/vec.h"
-#include "core/polygon/ltc_ggx_table.h"
 
 namespace penumbra::ltc_fit {
 

@@ -19,8 +19,8 @@
 #include "core/method/unshadowed_integrals.h"
 #include "core/strategies/ltc_strategy.h"
 #include "core/strategies/psa_strategy.h"
-#include "tests/core/polygon/ltc_test_reference.h"
-#include "tests/core/polygon/polygon_test_util.h"
+#include "tests/support/ltc_test_reference.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {

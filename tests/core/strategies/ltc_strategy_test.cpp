@@ -11,9 +11,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/polygon/ltc_ggx_table.h"
+#include "core/materials/ltc_ggx_table.h"
 #include "core/strategies/psa_strategy.h"
-#include "tests/core/polygon/polygon_test_util.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "core/polygon/projected_solid_angle.h"
+#include "core/math/projected_solid_angle.h"
 #include "core/strategies/psa_strategy.h"
 #include "core/strategies/solid_angle_strategy.h"
-#include "tests/core/polygon/polygon_test_util.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -1,12 +1,12 @@
-// core/math/spherical_triangle.h, core/polygon/solid_angle_polygon.h and
+// core/math/spherical_triangle.h, core/math/solid_angle_polygon.h and
 // core/math/spherical_rectangle.h: solid angles against
 // closed forms, the defining properties of the parametrizations, inverses and round trips.
 
 #include <gtest/gtest.h>
 
+#include "core/math/solid_angle_polygon.h"
 #include "core/math/spherical_rectangle.h"
 #include "core/math/spherical_triangle.h"
-#include "core/polygon/solid_angle_polygon.h"
 #include "tests/core/strategies/test_support.h"
 
 namespace penumbra {
@@ -34,7 +34,7 @@ TEST(TriangleSolidAngle, ClosedForms) {
   EXPECT_LE(relative_difference(omega, 0.5e-4 / 1600), 1e-7);
 }
 
-// Peters' construction (core/polygon/solid_angle_polygon.h, the `sa` of polygons and of the
+// Peters' construction (core/math/solid_angle_polygon.h, the `sa` of polygons and of the
 // SolidAngleStrategy's fans) on triangles of every size.
 TEST(SphericalTriangle, SubtriangleHasTheRequestedSolidAngleAndSamplesStayInside) {
   Rng rng(3);

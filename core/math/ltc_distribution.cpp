@@ -1,9 +1,9 @@
-#include "core/polygon/ltc_distribution.h"
+#include "core/math/ltc_distribution.h"
 
 #include <cmath>
 
-#include "core/polygon/polygon_limits.h"
-#include "core/polygon/projected_solid_angle.h"
+#include "core/math/polygon_limits.h"
+#include "core/math/projected_solid_angle.h"
 
 namespace penumbra {
 

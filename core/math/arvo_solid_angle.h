@@ -2,7 +2,7 @@
 // Arvo's solid angle sampling of a spherical triangle (Arvo 1995, "Stratified Sampling of
 // Spherical Triangles", Sec. 3), in its original trigonometric form, for a convex polygon's
 // triangle fan: the named variant `sa-arvo` that polygon_bench compares with Peters' form
-// (core/polygon/solid_angle_polygon.h, which is `sa`). Both implement the same map from [0,1)^2
+// (core/math/solid_angle_polygon.h, which is `sa`). Both implement the same map from [0,1)^2
 // to directions (Peters 2021 Sec. 5: the subtriangle (A, B, C') of area u.x * Omega, then the
 // arc B -> C' uniform in 1 - cos); Arvo's computes the three interior angles (three acos and
 // six cross products) and the area as alpha + beta + gamma - pi, which cancels for small
@@ -14,8 +14,8 @@
 #include <optional>
 #include <span>
 
+#include "core/math/polygon_limits.h"
 #include "core/math/vec.h"
-#include "core/polygon/polygon_limits.h"
 
 namespace penumbra {
 

@@ -1,61 +1,17 @@
-#include "core/polygon/projected_solid_angle.h"
+#include "core/math/projected_solid_angle.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
 
+#include "core/math/edge_ellipse.h"
 #include "core/math/horizon_clip.h"
+#include "core/math/plane_vectors.h"
 
 namespace penumbra {
 
 namespace {
-
-// Small 2D helpers (Vec2 carries no arithmetic in core/math/vec.h).
-Vec2 xy(const Vec3& v) {
-  return {v.x, v.y};
-}
-Vec2 add2(const Vec2& a, const Vec2& b) {
-  return {a.x + b.x, a.y + b.y};
-}
-Vec2 sub2(const Vec2& a, const Vec2& b) {
-  return {a.x - b.x, a.y - b.y};
-}
-Vec2 scale2(const Vec2& a, double s) {
-  return {a.x * s, a.y * s};
-}
-double dot2(const Vec2& a, const Vec2& b) {
-  return a.x * b.x + a.y * b.y;
-}
-// z of the 3D cross product, with Kahan's algorithm so that its sign is right (Sec. 3.7).
-double cross2(const Vec2& a, const Vec2& b) {
-  return difference_of_products(a.x, b.y, a.y, b.x);
-}
-// Peters' R: rotation by 90 degrees counter-clockwise.
-Vec2 rotate90(const Vec2& a) {
-  return {-a.y, a.x};
-}
-// Plain cross product, where a rounding error in the last bits cannot matter (the safeguard's
-// bracket test, the initialization's quad areas).
-double cross2_plain(const Vec2& a, const Vec2& b) {
-  return a.x * b.y - a.y * b.x;
-}
-Vec2 normalize2(const Vec2& a) {
-  double l = std::sqrt(dot2(a, a));
-  return l > 0 ? scale2(a, 1.0 / l) : a;
-}
-
-using Mat2 = std::array<double, 4>;  // row-major {xx, xy, yx, yy}
-
-// C w with C = c^2 I + m m^T.
-Vec2 apply_ellipse(const EdgeEllipse& e, const Vec2& w) {
-  double mw = dot2(e.m, w);
-  return {e.c * e.c * w.x + e.m.x * mw, e.c * e.c * w.y + e.m.y * mw};
-}
-// a^T C b.
-double ellipse_form(const EdgeEllipse& e, const Vec2& a, const Vec2& b) {
-  return e.c * e.c * dot2(a, b) + dot2(e.m, a) * dot2(e.m, b);
-}
 
 // Bisector of the unit directions a and b (at most 180 degrees apart, counter-clockwise from a):
 // their sum (Peters Eq. 8), or near 180 degrees the rotated difference, the stable form there.
@@ -86,22 +42,6 @@ bool inside_bracket(const Vec2& low, const Vec2& w, const Vec2& high) {
   return l2 > 0 && std::isfinite(l2) && cross2_plain(low, w) >= 0 && cross2_plain(w, high) >= 0;
 }
 
-// ellipse_radius_squared and ellipse_one_minus_radius_squared with one division.
-void radius_squared_and_complement(const EdgeEllipse& e, const Vec2& w, double* r2,
-                                   double* one_minus_r2) {
-  double cw = e.c * e.c * dot2(w, w);
-  double mw = dot2(e.m, w);
-  double denominator = cw + mw * mw;
-  if (!(denominator > 0)) {
-    *r2 = 0.0;
-    *one_minus_r2 = 1.0;
-    return;
-  }
-  double inverse = 1.0 / denominator;
-  *r2 = std::min(1.0, cw * inverse);
-  *one_minus_r2 = std::min(1.0, mw * mw * inverse);
-}
-
 // dot(N, v0) for the polygon's area vector N: its sign is that of det(v0, v1, v2) for consecutive
 // vertices of a planar convex polygon, 0 when the origin lies in the polygon's plane. Formed from
 // edge vectors to stay accurate for tiny, distant polygons.
@@ -111,44 +51,15 @@ double plane_offset(std::span<const Vec3> v) {
   return dot(area_vector, v[0]);
 }
 
-// |c| below this is treated as a great circle through the zenith: c^2 would underflow.
-constexpr double kZenithCircleC = 1e-140;
-
-}  // namespace
-
-EdgeEllipse edge_ellipse(const Vec3& a, const Vec3& b) {
-  Vec3 n = cross_accurate(a, b);
-  double l = length(n);
-  EdgeEllipse e;
-  if (!(l > 0) || !std::isfinite(l)) return e;  // a and b in the same direction: no arc
-  e.c = n.z / l;
-  e.m = {n.x / l, n.y / l};
-  if (std::abs(e.c) < kZenithCircleC) e.c = 0;
-  return e;
-}
-
-double ellipse_sector_area(const EdgeEllipse& e, const Vec2& s0, const Vec2& w) {
-  double abs_c = std::abs(e.c);
-  if (abs_c == 0) return 0.0;
-  return 0.5 * abs_c * std::atan2(abs_c * cross2(s0, w), ellipse_form(e, s0, w));
-}
-
-double ellipse_radius_squared(const EdgeEllipse& e, const Vec2& w) {
-  double denominator = ellipse_form(e, w, w);
-  return denominator > 0 ? std::min(1.0, e.c * e.c * dot2(w, w) / denominator) : 0.0;
-}
-
-double ellipse_one_minus_radius_squared(const EdgeEllipse& e, const Vec2& w) {
-  double denominator = ellipse_form(e, w, w);
-  double mw = dot2(e.m, w);
-  return denominator > 0 ? std::min(1.0, mw * mw / denominator) : 1.0;
-}
-
-int clip_polygon_to_upper_hemisphere(std::span<const Vec3> vertices, std::span<Vec3> out) {
-  // Strict crossings only: a vertex on the horizon is kept once, as itself.
+// The polygon clipped to z >= 0 by the one horizon clip (core/math/horizon_clip.h; strict
+// crossings only: a vertex on the horizon is kept once, as itself). The number of vertices
+// written to `out` (which holds vertices.size() + 1), 0 when fewer than 3 remain.
+int clip_to_upper_hemisphere(std::span<const Vec3> vertices, std::span<Vec3> out) {
   int count = int(clip_polygon_to_horizon(vertices, Vec3{0, 0, 1}, out));
   return count < 3 ? 0 : count;
 }
+
+}  // namespace
 
 double projected_solid_angle(std::span<const Vec3> vertices_local) {
   int n = static_cast<int>(vertices_local.size());
@@ -156,7 +67,7 @@ double projected_solid_angle(std::span<const Vec3> vertices_local) {
   // Seen edge-on (the shading point in the polygon's plane): no projected solid angle.
   if (!(plane_offset(vertices_local) != 0)) return 0.0;
   std::array<Vec3, kMaxClippedPolygonVertices> clipped;
-  int m = clip_polygon_to_upper_hemisphere(vertices_local, clipped);
+  int m = clip_to_upper_hemisphere(vertices_local, clipped);
   // Lambert's formula: each edge contributes the projected solid angle of the spherical triangle
   // (zenith, v_j, v_{j+1}).
   double sum = 0;
@@ -172,14 +83,6 @@ double projected_solid_angle(std::span<const Vec3> vertices_local) {
   return std::isfinite(result) ? result : 0.0;
 }
 
-Vec2 solve_homogeneous_quadratic(const Mat2& t) {
-  // w^T T w = t_xx w_x^2 + (t_xy + t_yx) w_x w_y + t_yy w_y^2 = 0 (Peters Eq. 6).
-  double half_b = 0.5 * (t[1] + t[2]);
-  double root = safe_sqrt(difference_of_products(half_b, half_b, t[0], t[3]));
-  if (half_b >= 0) return {half_b + root, -t[0]};
-  return {t[3], -half_b + root};
-}
-
 ProjectedSolidAngleSampler::ProjectedSolidAngleSampler(std::span<const Vec3> vertices_local,
                                                        int iterations)
     : iterations_(iterations) {
@@ -193,7 +96,7 @@ ProjectedSolidAngleSampler::ProjectedSolidAngleSampler(std::span<const Vec3> ver
 
   // Clip the polygon at the horizon (Sec. 3.1).
   std::array<Vec3, kMaxClippedPolygonVertices> clipped;
-  int m = clip_polygon_to_upper_hemisphere(vertices_local, clipped);
+  int m = clip_to_upper_hemisphere(vertices_local, clipped);
   if (m == 0) return;
   if (offset < 0) std::reverse(clipped.begin(), clipped.begin() + m);
 

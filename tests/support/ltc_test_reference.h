@@ -1,7 +1,7 @@
 #pragma once
 // Reference pieces for the LTC tests: the `ggx` specular lobe written out again from its
 // definition (Heitz 2014: GGX D, height-correlated Smith G2, Schlick F), independently of
-// core/materials (which penumbra_polygon does not link), and quadrature over the hemisphere.
+// core/materials (which the tests of core/math do not link), and quadrature over the hemisphere.
 
 #include <cmath>
 #include <functional>

@@ -1,4 +1,4 @@
-#include "core/polygon/arvo_solid_angle.h"
+#include "core/math/arvo_solid_angle.h"
 
 #include <algorithm>
 #include <cmath>

@@ -5,7 +5,7 @@
 // PENUMBRA_FULL_TESTS=1 raises the random-configuration count of the backward-error test from
 // 200,000 to the 10^6 of METHODS.md.
 
-#include "core/polygon/projected_solid_angle.h"
+#include "core/math/projected_solid_angle.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include <random>
 #include <vector>
 
-#include "polygon_test_util.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -28,46 +28,17 @@
 #include <optional>
 #include <span>
 
+#include "core/math/edge_ellipse.h"
+#include "core/math/polygon_limits.h"
 #include "core/math/vec.h"
-#include "core/polygon/polygon_limits.h"
 
 namespace penumbra {
-
-// The projection to the xy-plane of the great circle with unit normal (m.x, m.y, c).
-struct EdgeEllipse {
-  double c = 0;  // z of the unit normal; 0: the great circle passes through the zenith
-  Vec2 m;        // xy of the unit normal
-};
-
-// The great circle through the directions a and b (not necessarily normalized).
-EdgeEllipse edge_ellipse(const Vec3& a, const Vec3& b);
-
-// Signed area of the part of the ellipse's interior in the sector running counter-clockwise
-// from direction s0 to direction w (at most 180 degrees): Peters Eq. 1 in homogeneous form,
-//   (|c| / 2) atan2(|c| cross(s0, w), s0^T C w).
-double ellipse_sector_area(const EdgeEllipse& ellipse, const Vec2& s0, const Vec2& w);
-
-// Squared radius at which the ray through direction w meets the ellipse, and 1 minus it (formed
-// without cancellation near the horizon).
-double ellipse_radius_squared(const EdgeEllipse& ellipse, const Vec2& w);
-double ellipse_one_minus_radius_squared(const EdgeEllipse& ellipse, const Vec2& w);
-
-// Clips a convex polygon to the upper half-space z >= 0 (Sutherland-Hodgman against one plane).
-// Returns the number of vertices written to `out` (0 if nothing remains). `out` must hold
-// vertices.size() + 1 entries.
-int clip_polygon_to_upper_hemisphere(std::span<const Vec3> vertices, std::span<Vec3> out);
 
 // Closed-form projected solid angle of a convex polygon given relative to the shading point in
 // its local frame: the part above the horizon, by Lambert's formula
 //   (1/2) sum_j angle(v_j, v_{j+1}) * (n_j . z) / |n_j|,  n_j = v_j x v_{j+1}.
 // Independent of the polygon's orientation. 0 for fewer than 3 or more than kMaxPolygonVertices.
 double projected_solid_angle(std::span<const Vec3> vertices_local);
-
-// The root of the homogeneous quadratic w^T T w = 0 that Peters' Eq. 6 selects (Blinn's stable
-// formula specialized to one root; Peters Supplement A.3). T is row-major {xx, xy, yx, yy}.
-// The sampler itself solves the same quadratics in step form (see README.md: Eq. 6 picks its
-// root by a sign that is rounding noise where the two roots nearly coincide).
-Vec2 solve_homogeneous_quadratic(const std::array<double, 4>& t);
 
 // A convex polygon prepared once per shading point for projected solid angle sampling.
 class ProjectedSolidAngleSampler {

@@ -1,5 +1,5 @@
 #pragma once
-// The geometry the polygon strategies (psa_strategy.h, peters_sa_strategy.h) share: a quad or
+// The geometry the polygon strategies (core/strategies: psa, ltc) share: a quad or
 // polygon light as a convex vertex list with its emission normal, the one-sided emission test,
 // the step from a sampled direction to a point on the light's plane, and the point-in-polygon
 // test behind pdf(point).
@@ -8,8 +8,8 @@
 #include <optional>
 #include <span>
 
+#include "core/math/polygon_limits.h"
 #include "core/math/vec.h"
-#include "core/polygon/polygon_limits.h"
 #include "core/scene/scene.h"
 
 namespace penumbra {

@@ -3,14 +3,14 @@
 // The distribution itself is chi-square tested through SolidAngleStrategy in
 // tests/core/strategies/polygon_strategies_test.cpp.
 
-#include "core/polygon/solid_angle_polygon.h"
+#include "core/math/solid_angle_polygon.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
 #include <vector>
 
-#include "polygon_test_util.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {

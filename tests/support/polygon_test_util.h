@@ -12,9 +12,9 @@
 #include <random>
 #include <vector>
 
+#include "core/lights/shading_point.h"
 #include "core/math/vec.h"
 #include "core/scene/scene.h"
-#include "core/strategies/strategy.h"
 
 namespace penumbra::polygon_test {
 

@@ -17,9 +17,9 @@
 #include <optional>
 #include <span>
 
+#include "core/math/polygon_limits.h"
 #include "core/math/spherical_triangle.h"  // triangle_solid_angle (van Oosterom & Strackee)
 #include "core/math/vec.h"
-#include "core/polygon/polygon_limits.h"
 
 namespace penumbra {
 

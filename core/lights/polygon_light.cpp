@@ -1,4 +1,4 @@
-#include "core/polygon/polygon_light.h"
+#include "core/lights/polygon_light.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,17 +1,17 @@
-// The committed LTC table (core/polygon/ltc_ggx_table.h) against the `ggx` lobe it was fitted
+// The committed LTC table (core/materials/ltc_ggx_table.h) against the `ggx` lobe it was fitted
 // to, by quadrature: the lobe's albedo and Fresnel integral, the recorded fit error (the L1
 // distance of the normalized lobe and the LTC), the integral over polygons (which must differ
 // by at most the L1 distance times the albedo), and the interpolated lookups between cells.
 
-#include "core/polygon/ltc_ggx_table.h"
+#include "core/materials/ltc_ggx_table.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <vector>
 
-#include "ltc_test_reference.h"
-#include "polygon_test_util.h"
+#include "tests/support/ltc_test_reference.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/polygon/solid_angle_polygon.h"
+#include "core/math/solid_angle_polygon.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "core/polygon/ltc_ggx_table.h"
+#include "core/materials/ltc_ggx_table.h"
 
 #include <algorithm>
 #include <array>
@@ -8,7 +8,7 @@ namespace penumbra {
 namespace {
 
 // The generated table: kGgxLtcTableSize^2 cells, row-major (row = roughness index).
-#include "core/polygon/data/ggx_ltc_table.inc"
+#include "core/materials/data/ggx_ltc_table.inc"
 
 static_assert(kGgxLtcTable.size() == size_t(kGgxLtcTableSize * kGgxLtcTableSize),
               "the generated table does not match kGgxLtcTableSize: rerun tools/ltc_fit");

@@ -1,18 +1,18 @@
-// Arvo's original spherical triangle sampling (core/polygon/arvo_solid_angle.h, the `sa-arvo`
+// Arvo's original spherical triangle sampling (core/math/arvo_solid_angle.h, the `sa-arvo`
 // variant of polygon_bench): the same map as Peters' construction (Peters 2021 Sec. 5), so for
 // well-conditioned triangles both give the same direction for the same (u.x, u.y); its Girard
 // area agrees with van Oosterom & Strackee's there; samples lie in the polygon; for tiny distant
 // triangles (Peters Fig. 7) its area loses most digits but it stays finite.
 
-#include "core/polygon/arvo_solid_angle.h"
+#include "core/math/arvo_solid_angle.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <random>
 
-#include "core/polygon/solid_angle_polygon.h"
-#include "polygon_test_util.h"
+#include "core/math/solid_angle_polygon.h"
+#include "tests/support/polygon_test_util.h"
 
 namespace penumbra {
 namespace {
