@@ -142,9 +142,13 @@ std::chrono::milliseconds Coordinator::dead_after() const {
   return period * std::max<uint32_t>(options_.missed_heartbeats, 1) + period / 2;
 }
 
+std::chrono::milliseconds Coordinator::expiry_period() const {
+  return std::max(std::chrono::milliseconds(10),
+                  std::min(options_.lease_time, heartbeat_period()) / 4);
+}
+
 void Coordinator::expiry_loop() {
-  auto period = std::max(std::chrono::milliseconds(10),
-                         std::min(options_.lease_time, heartbeat_period()) / 4);
+  const auto period = expiry_period();
   std::unique_lock lock(expiry_mutex_);
   while (!expiry_wake_.wait_for(lock, period, [this] { return stopping_; })) {
     lock.unlock();
@@ -1304,12 +1308,18 @@ void Coordinator::expire_leases() {
       scheduler_.requeue(lease.task);
       ++counters_.leases_expired;
     }
-    // Dead workers: their tasks go to the others now, not when the leases would expire.
+    // Dead workers: their tasks go to the others now, not when the leases would expire. A pass
+    // more than two periods after the previous one follows a time the coordinator itself heard
+    // nobody (the process stopped or starved, the lock held through a slow disk write): the
+    // workers' calls that waited meanwhile have not landed yet, so nobody is declared dead in
+    // it; the next pass, a period later, decides.
     const auto now = std::chrono::steady_clock::now();
+    const bool deaf_before = last_expiry_pass_ && now - *last_expiry_pass_ > 2 * expiry_period();
+    last_expiry_pass_ = now;
     for (auto it = workers_.begin(); it != workers_.end();) {
       Worker& worker = it->second;
       const auto silence = now - worker.last_contact;
-      if (!worker.dead && worker.calls_in_flight == 0 && silence > dead_after()) {
+      if (!deaf_before && !worker.dead && worker.calls_in_flight == 0 && silence > dead_after()) {
         worker.dead = true;
         ++counters_.workers_lost;
         std::vector<Lease> lost = leases_.release_worker(it->first);

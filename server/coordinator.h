@@ -53,10 +53,12 @@ struct CoordinatorOptions {
   // makes a late result of a lost lease recognisable (only the current attempt token counts).
   std::chrono::milliseconds lease_time{30'000};
   // Workers heartbeat every heartbeat_interval (at most lease_time / 3); any call counts as
-  // contact. A worker silent for missed_heartbeats intervals and half an interval more is dead:
-  // its leases are revoked and its tasks queued again at once, long before they would expire.
+  // contact. A worker silent for missed_heartbeats intervals and half an interval more is dead
+  // (by default at its first missed heartbeat: 1.5 s of silence): its leases are revoked and its
+  // tasks queued again at once, long before they would expire. The lease stays the fence: a
+  // result or heartbeat of a worker declared dead names a revoked attempt token and is dropped.
   std::chrono::milliseconds heartbeat_interval{1'000};
-  uint32_t missed_heartbeats = 2;
+  uint32_t missed_heartbeats = 1;
   // A dead worker leaves the worker list after this long (0: never).
   std::chrono::milliseconds forget_worker_after{300'000};
   uint32_t default_tile_size = 64;
@@ -181,6 +183,8 @@ class Coordinator {
   // silence after which a worker is dead.
   std::chrono::milliseconds heartbeat_period() const;
   std::chrono::milliseconds dead_after() const;
+  // How often the background thread calls expire_leases.
+  std::chrono::milliseconds expiry_period() const;
 
   static std::string job_name(uint64_t job_id);
   const CoordinatorOptions& options() const { return options_; }
@@ -249,6 +253,9 @@ class Coordinator {
   LeaseTable leases_;
   std::map<std::string, Worker> workers_;
   uint64_t next_worker_ = 1;
+  // When expire_leases last held the lock: a pass that comes much later than its period found a
+  // coordinator that heard nobody meanwhile (stopped, or its lock held through a slow write).
+  std::optional<SteadyTime> last_expiry_pass_;
   std::map<uint64_t, std::pair<uint64_t, std::function<void()>>> subscriptions_;
   std::function<void()> batch_listener_;
   uint64_t next_subscription_ = 1;

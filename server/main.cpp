@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--missed-heartbeats", options.missed_heartbeats,
                  "a worker silent this many heartbeats (and half one more) is dead: its tasks "
-                 "are queued again at once")
+                 "are queued again at once (1: at its first missed heartbeat)")
       ->check(CLI::Range(1u, 100u))
       ->capture_default_str();
   app.add_option("--forget-worker-seconds", forget_worker_seconds,

@@ -154,8 +154,16 @@ int RenderWorker::run() {
     }
     reset_backoff();
     if (!leased) {
+      // Idle until the next poll, or until the next heartbeat is due if that comes first.
+      using Seconds = std::chrono::duration<double>;
+      Seconds wait = options_.idle_poll;
+      if (!worker_id_.empty()) {
+        const Seconds due =
+            Seconds(last_heartbeat_ - std::chrono::steady_clock::now()) + heartbeat_period_;
+        wait = std::clamp(due, Seconds(0), wait);
+      }
       std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, options_.idle_poll);
+      wake_.wait_for(lock, wait);
     }
   }
   {
@@ -218,6 +226,10 @@ bool RenderWorker::send_heartbeat() {
     for (const Outgoing& outgoing : outbox_) request.add_attempt_tokens(outgoing.token());
   }
   v1::HeartbeatResponse response;
+  // The next heartbeat is due a period after this one was sent, not after its answer came: the
+  // coordinator declares a worker dead at its first missed heartbeat, so the round trip must not
+  // add up from one heartbeat to the next.
+  const auto sent = std::chrono::steady_clock::now();
   auto context = context_with_deadline(std::chrono::seconds(10));
   grpc::Status status = stub_->Heartbeat(context.get(), request, &response);
   if (status.error_code() == grpc::StatusCode::NOT_FOUND) {
@@ -230,7 +242,7 @@ bool RenderWorker::send_heartbeat() {
     return true;
   }
   if (!status.ok()) return false;
-  last_heartbeat_ = std::chrono::steady_clock::now();
+  last_heartbeat_ = sent;
   if (response.revoked_tokens_size() == 0) return true;
   std::lock_guard lock(mutex_);
   for (const std::string& token : response.revoked_tokens()) {

@@ -283,11 +283,13 @@ TEST_F(CoordinatorTest, AFinishedJobsPreviewIsItsImage) {
 // dropped (the lease is the fence). Its name is refused to another process while it is alive,
 // taken over once it is dead (a restart keeps its id), and it leaves the list after
 // forget_worker_after.
-TEST_F(CoordinatorTest, ADeadWorkersTasksAreReassignedAfterTwoMissedHeartbeats) {
+TEST_F(CoordinatorTest, ADeadWorkersTasksAreReassignedAtItsFirstMissedHeartbeat) {
   options_.lease_time = 60s;  // expiry is not what reassigns here
-  options_.heartbeat_interval = 200ms;
-  options_.missed_heartbeats = 2;  // dead after 500 ms of silence
-  options_.forget_worker_after = 800ms;
+  options_.heartbeat_interval = 600ms;
+  // The default: dead at the first missed heartbeat, after 1.5 intervals of silence (900 ms;
+  // the expiry thread looks every 150 ms). Two missed heartbeats would be 1.5 s.
+  options_.missed_heartbeats = CoordinatorOptions{}.missed_heartbeats;
+  options_.forget_worker_after = 1200ms;
   auto coordinator = make();
   const std::string dying = register_worker(*coordinator, "dying");
   const std::string alive = register_worker(*coordinator, "alive");
@@ -295,25 +297,27 @@ TEST_F(CoordinatorTest, ADeadWorkersTasksAreReassignedAfterTwoMissedHeartbeats) 
   EXPECT_THROW(register_worker(*coordinator, "dying"), FarmError) << "a live worker's name";
   std::string job = coordinator->submit(spec(4)).job_id();  // 6 tasks
   std::vector<v1::Task> lost = lease(*coordinator, dying, 3);
+  const auto last_contact = std::chrono::steady_clock::now();
   ASSERT_EQ(lost.size(), 3u);
   for (const v1::Task& task : lease(*coordinator, alive, 3))
     EXPECT_TRUE(complete(*coordinator, alive, task));
   EXPECT_EQ(coordinator->status(job).tasks_leased(), 3u);
-  // `alive` heartbeats every 50 ms; `dying` is silent. Its tasks come back within a second.
-  const auto start = std::chrono::steady_clock::now();
-  std::vector<v1::Task> reassigned;
-  while (reassigned.size() < 3 && std::chrono::steady_clock::now() - start < 3s) {
-    std::this_thread::sleep_for(50ms);
+  // `alive` heartbeats every 5 ms; `dying` is silent. Its tasks come back once it is dead.
+  while (coordinator->counters().workers_lost == 0 &&
+         std::chrono::steady_clock::now() - last_contact < 3s) {
+    std::this_thread::sleep_for(5ms);
     v1::HeartbeatRequest heartbeat;
     heartbeat.set_worker_id(alive);
     coordinator->heartbeat(heartbeat);
-    for (const v1::Task& task : lease(*coordinator, alive, 3)) reassigned.push_back(task);
   }
   const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - last_contact).count();
+  ASSERT_EQ(coordinator->counters().workers_lost, 1u);
+  EXPECT_GE(seconds, 0.85) << "declared dead before a heartbeat was missed";
+  EXPECT_LT(seconds, 1.35) << "not at the first missed heartbeat";
+  EXPECT_EQ(coordinator->status(job).tasks_leased(), 0u);
+  std::vector<v1::Task> reassigned = lease(*coordinator, alive, 3);
   ASSERT_EQ(reassigned.size(), 3u);
-  EXPECT_GE(seconds, 0.45) << "reassigned before two heartbeats were missed";
-  EXPECT_LT(seconds, 2.0);
   EXPECT_EQ(coordinator->counters().workers_lost, 1u);
   for (const v1::WorkerInfo& worker : coordinator->workers())
     EXPECT_EQ(worker.alive(), worker.worker_id() == alive) << worker.worker_id();
@@ -324,6 +328,11 @@ TEST_F(CoordinatorTest, ADeadWorkersTasksAreReassignedAfterTwoMissedHeartbeats) 
       testing::same_bits(coordinator->result_film(job).color, expected_film(40, 24, 4).color));
   // Dead, the name may be taken over (a restart keeps its id) ...
   EXPECT_EQ(register_worker(*coordinator, "dying"), "dying");
+  // The leases stayed the fence: the old attempt tokens are revoked, whoever names them.
+  v1::HeartbeatRequest stale;
+  stale.set_worker_id(dying);
+  for (const v1::Task& task : lost) stale.add_attempt_tokens(task.attempt_token());
+  EXPECT_EQ(coordinator->heartbeat(stale).revoked_tokens_size(), 3);
   // ... and a dead worker is forgotten after forget_worker_after.
   const std::string gone = register_worker(*coordinator, "gone");
   bool listed = true;
