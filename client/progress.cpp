@@ -68,8 +68,11 @@ std::string format_progress(const ProgressState& state, bool tty, int columns, i
   else if (bounded && state.done >= state.total)
     eta = "done in " + format_duration(state.elapsed);
 
+  // Rounded down: 100% only once everything is done (a job with a last task still leased to a
+  // dead worker is at 99%, not 100%).
+  const double percent_value = std::floor(100 * fraction);
   char percent[16] = "";
-  if (bounded) std::snprintf(percent, sizeof percent, "%3.0f%%", 100 * fraction);
+  if (bounded) std::snprintf(percent, sizeof percent, "%3.0f%%", percent_value);
   std::string line;
   if (tty) {
     if (bounded) {
@@ -86,7 +89,7 @@ std::string format_progress(const ProgressState& state, bool tty, int columns, i
   }
   line = state.label.empty() ? amount : state.label + ": " + amount;
   if (bounded) {
-    std::snprintf(percent, sizeof percent, "%.0f%%", 100 * fraction);
+    std::snprintf(percent, sizeof percent, "%.0f%%", percent_value);
     line += std::string(" (") + percent + ")";
   }
   for (const std::string* part : {&std::as_const(rate), &std::as_const(eta), &state.extra})

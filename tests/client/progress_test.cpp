@@ -121,6 +121,31 @@ TEST(Progress, QuietWritesNothing) {
   std::fclose(file);
 }
 
+// The last tasks still leased (to a worker that may have died): not 100% until they are done,
+// and the leased ones are shown.
+TEST(Progress, LeasedButUnfinishedTasksAreShownAndNotCountedAsDone) {
+  JobProgress job;
+  job.job_id = "job-7";
+  job.state = "running";
+  job.spp_budget = 128;
+  job.passes_complete = 120;
+  job.tiles_complete = 23;
+  job.tiles_total = 24;
+  job.tasks_complete = 383;
+  job.tasks_total = 384;
+  job.tasks_leased = 1;
+  job.wall_seconds = 4;
+  const std::string plain = format_progress(job_progress_state(job), false);
+  EXPECT_NE(plain.find("383/384 tasks (99%)"), std::string::npos) << plain;
+  EXPECT_NE(plain.find("leased 1"), std::string::npos) << plain;
+  const std::string bar = format_progress(job_progress_state(job), true, 200, 10);
+  EXPECT_EQ(bar.rfind("[#########-]  99%  383/384 tasks", 0), 0u) << bar;
+  job.tasks_complete = 384;
+  job.tasks_leased = 0;
+  job.done = true;
+  EXPECT_NE(format_progress(job_progress_state(job), false).find("(100%)"), std::string::npos);
+}
+
 TEST(Progress, FarmJobShowsTasksOrComputeSecondsWithSppTilesAndMrse) {
   JobProgress job;
   job.job_id = "job-4";
