@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -199,6 +200,30 @@ TEST_F(CliChecks, RenderRefusesAPngOutputAndCarriesTheScenesWarnings) {
   EXPECT_TRUE(fs::exists(path("out.png"))) << "the preview beside the EXR";
 }
 
+// A bad reference or output folder is refused before the render starts: a 60-second render
+// with a missing reference ends at once, without output (it used to render first, write the
+// image and exit 1).
+TEST_F(CliChecks, RenderRefusesABadReferenceOrOutputFolderBeforeItRenders) {
+  const auto start = std::chrono::steady_clock::now();
+  CliRun missing = run(dir_, {"render", scene_, "--seconds", "60", "-o", path("out.exr"),
+                              "--reference", path("nothing.exr")});
+  EXPECT_NE(missing.code, 0);
+  EXPECT_NE(missing.output.find("nothing.exr"), std::string::npos) << missing.output;
+  Image small(8, 6);
+  write_exr(path("small.exr"), small, nullptr, {});
+  CliRun resolution = run(dir_, {"render", scene_, "--seconds", "60", "-o", path("out.exr"),
+                                 "--reference", path("small.exr")});
+  EXPECT_NE(resolution.code, 0);
+  EXPECT_NE(resolution.output.find("8x6"), std::string::npos) << resolution.output;
+  CliRun folder = run(dir_, {"render", scene_, "--seconds", "60", "-o", path("missing/out.exr")});
+  EXPECT_NE(folder.code, 0);
+  EXPECT_NE(folder.output.find("does not exist"), std::string::npos) << folder.output;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20))
+      << "a refused render rendered first";
+  EXPECT_FALSE(fs::exists(path("out.exr")));
+  EXPECT_FALSE(fs::exists(path("out.png")));
+}
+
 // `penumbra verify`: an unbiased method passes against the exact reference (exit 0); against
 // the exact reference of a scene whose light is 10% brighter (a reference EXR of another scene,
 // accepted only with --accept-reference-mismatch) it fails with exit code 4, naming the blocks.
@@ -235,7 +260,23 @@ TEST_F(CliChecks, OptionsAreCheckedAndTheirDefaultsShown) {
   EXPECT_NE(seconds.code, 0);
   EXPECT_NE(seconds.output.find("--seconds"), std::string::npos) << seconds.output;
   EXPECT_LT(seconds.output.size(), 400u) << "a 309-digit bound? " << seconds.output;
-  // `submit`, `list` and the other farm commands exist only in a build with the farm.
+  // Both budgets: render stops at whichever comes first, and says so; submit refuses (below).
+  CliRun both =
+      run(dir_, {"render", scene_, "--spp", "2", "--seconds", "100", "-o", path("both.exr")});
+  ASSERT_EQ(both.code, 0) << both.output;
+  EXPECT_NE(both.output.find("--seconds 100 with --spp 2: renders until either is reached"),
+            std::string::npos)
+      << both.output;
+  ImageMetadata metadata;
+  read_exr(path("both.exr"), &metadata);
+  EXPECT_EQ(metadata["penumbra:spp"], "2") << "--spp was ignored";
+  // The defaults are in --help.
+  CliRun render_help = run(dir_, {"render", "--help"});
+  for (const char* text : {"the scene's own, else sa", "the scene's own, else stratified",
+                           "the scene's, else 16", "out.exr"})
+    EXPECT_NE(render_help.output.find(text), std::string::npos) << text << "\n"
+                                                                << render_help.output;
+    // `submit`, `list` and the other farm commands exist only in a build with the farm.
 #if !__has_include("penumbra/v1/farm.pb.h")
   GTEST_SKIP() << "the farm commands are not built (PENUMBRA_FARM=OFF); render's checks passed";
 #endif
@@ -243,6 +284,10 @@ TEST_F(CliChecks, OptionsAreCheckedAndTheirDefaultsShown) {
   EXPECT_NE(zero.code, 0);
   EXPECT_NE(zero.output.find("--spp"), std::string::npos) << zero.output;
   EXPECT_EQ(zero.output.find("exactly one budget"), std::string::npos) << zero.output;
+  CliRun budgets = run(dir_, {"submit", scene_, "--spp", "4", "--seconds", "2"});
+  EXPECT_NE(budgets.code, 0);
+  EXPECT_NE(budgets.output.find("--spp and --seconds both given"), std::string::npos)
+      << budgets.output;
   CliRun help = run(dir_, {"submit", "--help"});
   EXPECT_NE(help.output.find("-m,--method"), std::string::npos) << help.output;
   EXPECT_NE(help.output.find("-s,--sampler"), std::string::npos);
