@@ -20,6 +20,7 @@
 #include <string>
 #include <thread>
 
+#include "client/batch_summary.h"
 #include "client/commands.h"
 #include "client/progress.h"
 #include "client/read_file.h"
@@ -138,8 +139,8 @@ void print_status(const v1::BatchStatus& status) {
   }
 }
 
-// The summary table from a written result folder: per method, its equal-time runs (else its
-// largest spp level), MRSE over the image and each region.
+// The summary table from a written result folder (client/batch_summary.h), after the warning
+// for a reference barely cleaner than the runs.
 void print_summary(const std::filesystem::path& dir) {
   std::ifstream in(dir / "batch.json");
   nlohmann::json index = nlohmann::json::parse(in);
@@ -149,34 +150,7 @@ void print_summary(const std::filesystem::path& dir) {
   } catch (const std::exception&) {
     // The table below still prints; the report reads the folder again and names any problem.
   }
-  std::vector<std::string> regions = {"image"};
-  for (const auto& region : index["regions"]) regions.push_back(region["name"]);
-  // Each MRSE column as wide as its header (never cut: "MRSE penumbra-edge1").
-  std::vector<int> widths;
-  std::printf("%-34s %6s %9s", "method", "spp", "compute s");
-  for (const std::string& region : regions) {
-    const std::string header = "MRSE " + region;
-    widths.push_back(std::max<int>(12, int(header.size())));
-    std::printf(" %*s", widths.back(), header.c_str());
-  }
-  std::printf("\n");
-  for (const auto& method : index["methods"]) {
-    std::string label = method["label"];
-    if (method.contains("error")) {
-      std::printf("%-34s refused: %s\n", label.c_str(), method["error"].get<std::string>().c_str());
-      continue;
-    }
-    for (const auto& run : method["runs"]) {
-      if (method["budget_seconds"].is_number() && !run.value("equal_time", true)) continue;
-      std::printf("%-34s %6u %9.2f", label.c_str(), run["spp"].get<unsigned>(),
-                  run["compute_seconds"].get<double>());
-      for (size_t r = 0; r < regions.size(); ++r)
-        for (const auto& error : run["errors"])
-          if (error["region"] == regions[r])
-            std::printf(" %*.4g", widths[r], error["mrse"].get<double>());
-      std::printf("  (r%u)\n", run["repeat"].get<unsigned>());
-    }
-  }
+  std::fputs(batch_summary_table(index).c_str(), stdout);
 }
 
 std::string folder_of(const std::string& path) {
