@@ -3,6 +3,8 @@
 #if __has_include("penumbra/v1/farm.pb.h")
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "core/image/image.h"
 #include "server/embedded_farm.h"
 #include "tests/batch/batch_test_support.h"
@@ -83,6 +85,21 @@ TEST_F(BatchServiceErrors, BadSpecsNameTheirField) {
   wrong_size.set_reference_exr(encode_exr(small, nullptr, {}));
   expect_status([&] { client_->submit(wrong_size); }, grpc::StatusCode::INVALID_ARGUMENT,
                 "$.reference");
+
+  // A scene whose reader warns (a misspelled key): refused under "strict": true, naming the key.
+  {
+    std::ifstream in(dir_ / "batch-test.json");
+    std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    json.replace(json.find("\"fov_y_deg\": 40"), 15, "\"fov_y_deg\": 40, \"fovy\": 30");
+    std::ofstream(dir_ / "typo.json") << json;
+  }
+  v1::SubmitBatchRequest strict =
+      request(spec(R"(["sa"])", R"({"spp": [2]})", R"(, "strict": true)"));
+  *strict.mutable_scene() = pack_scene_file((dir_ / "typo.json").string());
+  expect_status([&] { client_->submit(strict); }, grpc::StatusCode::INVALID_ARGUMENT,
+                "$.strict: the scene has 1 warning(s)");
+  expect_status([&] { client_->submit(strict); }, grpc::StatusCode::INVALID_ARGUMENT,
+                "$.camera.fovy");
 
   // No scene package.
   v1::SubmitBatchRequest no_scene = request(spec(R"(["sa"])", R"({"spp": [2]})"));
