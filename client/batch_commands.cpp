@@ -32,6 +32,7 @@
 #include "client/exact_reference_cache.h"
 #include "core/batch/batch_spec.h"
 #include "core/report/batch_report.h"
+#include "core/report/deep_reference_check.h"
 #include "proto/support/batch_client.h"
 #include "proto/support/scene_packing.h"
 #include "proto/support/state_names.h"
@@ -115,6 +116,20 @@ void print_status(const v1::BatchStatus& status) {
               reference.job_id().c_str(), reference.job_id().empty() ? "" : " ",
               reference.method().c_str(), reference.sampler().c_str(), reference.spp(),
               reference.cached() ? " (cached)" : "");
+  if (reference.sizing().sized()) {
+    const v1::BatchReferenceSizing& sizing = reference.sizing();
+    std::printf(
+        "           sized: the %g%% target asked for %.0f spp%s; predicted reference share "
+        "%.2f%% in \"%s\"\n",
+        100 * sizing.target_share(), std::ceil(sizing.required_spp()),
+        sizing.capped()
+            ? (", capped by max_seconds = " + std::to_string(sizing.max_seconds())).c_str()
+            : "",
+        100 * sizing.predicted_share(), sizing.deciding_region().c_str());
+  } else if (reference.sizing().probe_jobs_size() > 0) {
+    std::printf("           sizing from %d probes of %u spp\n",
+                reference.sizing().probe_jobs_size(), reference.sizing().probe_spp());
+  }
   std::printf("jobs       %u/%u done; %.2f compute s, %.2f wall s\n", status.jobs_done(),
               status.jobs_total(), status.compute_seconds(), status.wall_seconds());
   std::printf("%-32s %-10s %8s %10s %10s %10s\n", "label", "run", "spp", "compute s", "wall s",
@@ -145,7 +160,10 @@ void print_summary(const std::filesystem::path& dir) {
   std::ifstream in(dir / "batch.json");
   nlohmann::json index = nlohmann::json::parse(in);
   try {
-    if (std::string warning = reference_depth_warning(read_batch_result(dir)); !warning.empty())
+    const BatchResult result = read_batch_result(dir);
+    if (result.reference.sizing)
+      std::printf("reference: %s\n", reference_sizing_text(result.reference).c_str());
+    if (std::string warning = reference_depth_warning(result); !warning.empty())
       std::fprintf(stderr, "penumbra: warning: %s\n", warning.c_str());
   } catch (const std::exception&) {
     // The table below still prints; the report reads the folder again and names any problem.
@@ -171,13 +189,18 @@ std::string attach_exact_reference(v1::SubmitBatchRequest& request) {
   std::fflush(stdout);
   CachedExactReference reference = exact_reference_for(scene, spec.reference);
   if (reference.cached)
-    std::printf("batch: exact reference read from the cache %s (%.1f%% of camera samples exact)\n",
-                reference.path.string().c_str(), 100 * reference.exact_share);
+    std::printf(
+        "batch: exact reference read from the cache %s (%.1f%% of camera samples exact; %.1f%% of "
+        "the pixels have a fallback sample, marked in its exact.mask channel)\n",
+        reference.path.string().c_str(), 100 * reference.exact_share,
+        100 * reference.fallback_pixel_share);
   else
     std::printf(
-        "batch: exact reference rendered in %.1f compute s (%.1f%% of camera samples exact), "
-        "cached as %s\n",
-        reference.compute_seconds, 100 * reference.exact_share, reference.path.string().c_str());
+        "batch: exact reference rendered in %.1f compute s (%.1f%% of camera samples exact; "
+        "%.1f%% of the pixels have a fallback sample, marked in its exact.mask channel), cached "
+        "as %s\n",
+        reference.compute_seconds, 100 * reference.exact_share,
+        100 * reference.fallback_pixel_share, reference.path.string().c_str());
   request.set_reference_exr(std::move(reference.exr));
   return scene.content_hash;
 }
@@ -370,6 +393,33 @@ void add_batch_commands(CLI::App& app) {
     options.reference_exr = *report_reference;
     write_batch_report(source, out, options);
     std::printf("wrote %s\n", (out / "report.html").string().c_str());
+  });
+
+  struct DepthArguments {
+    std::string folder, deep, json;
+    double tolerance = 0.10;
+  };
+  auto depth_arguments = std::make_shared<DepthArguments>();
+  CLI::App* depth = app.add_subcommand(
+      "check-depth",
+      "Check a batch's table against a deeper reference: every cell's corrected MRSE within "
+      "--tolerance of the same runs' MRSE against DEEP (exit status 1 when not)");
+  depth->add_option("folder", depth_arguments->folder, "Batch result folder")->required();
+  depth->add_option("--deep", depth_arguments->deep, "The deeper reference EXR")->required();
+  depth->add_option("--tolerance", depth_arguments->tolerance, "Relative tolerance")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  depth->add_option("--json", depth_arguments->json, "Also write the check as JSON");
+  depth->callback([depth_arguments] {
+    const DeepCheck check = check_against_deep_reference(
+        depth_arguments->folder, depth_arguments->deep, depth_arguments->tolerance);
+    std::printf("%s", deep_check_text(check).c_str());
+    if (!depth_arguments->json.empty()) {
+      std::ofstream out(depth_arguments->json);
+      out << deep_check_json(check).dump(2) << "\n";
+      if (!out) throw std::runtime_error("cannot write " + depth_arguments->json);
+    }
+    if (!check.passed()) set_command_exit_code(1);
   });
 }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "client/cli_options.h"
 #include "client/commands.h"
@@ -56,6 +57,10 @@ void add_exact_commands(CLI::App& app) {
     std::ofstream out(args->output);
     out << text << "\n";
     if (!out) throw std::runtime_error("cannot write " + args->output);
+    const nlohmann::json doc = nlohmann::json::parse(text);
+    std::printf("%s: %zu points, %.1f%% exact (%d by the fallback %s)\n", args->output.c_str(),
+                doc["points"].size(), 100.0 * doc["exact_share"].get<double>(),
+                doc["fallback_points"].get<int>(), args->fallback.c_str());
   });
 
   struct ReferenceArgs {
@@ -92,13 +97,17 @@ void add_exact_commands(CLI::App& app) {
     options.threads = rargs->threads;
     ExactReferenceImage image = render_exact_reference(scene, options);
     write_exr(rargs->output, image.film.color, &image.film.variance,
-              exact_reference_metadata(*scene, options, image));
+              exact_reference_metadata(*scene, options, image),
+              {ExrChannel{kExactMaskChannel, image.fallback_mask()}});
     const double total = double(image.exact_samples + image.fallback_samples);
     std::printf(
-        "%s: %u camera samples per pixel, %.1f%% exact, %.2f s compute (%.2f s wall), "
-        "%.2f us per camera sample; %.1f candidate occluders per exact point\n",
+        "%s: %u camera samples per pixel, %.1f%% exact (%.1f%% of the pixels have a %s sample, "
+        "marked in the EXR's %s channel), %.2f s compute (%.2f s wall), %.2f us per camera "
+        "sample; %.1f candidate occluders per exact point\n",
         rargs->output.c_str(), options.camera_samples, 100.0 * double(image.exact_samples) / total,
-        image.compute_seconds, image.wall_seconds, 1e6 * image.compute_seconds / total,
+        100.0 * image.fallback_pixel_share(), options.shading.fallback_method.c_str(),
+        kExactMaskChannel, image.compute_seconds, image.wall_seconds,
+        1e6 * image.compute_seconds / total,
         image.exact_samples ? double(image.stats.candidates) / double(image.exact_samples) : 0.0);
   });
 }

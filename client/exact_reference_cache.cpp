@@ -37,7 +37,7 @@ std::filesystem::path exact_reference_cache_dir() {
 
 CachedExactReference exact_reference_for(const Scene& scene, const BatchReferenceSpec& reference) {
   const std::string key =
-      scene.content_hash + "|" + kBuildFlavour + "|exact|" +
+      scene.content_hash + "|" + kBuildFlavour + "|exact+mask|" +
       std::to_string(reference.camera_samples) + "|" + reference.fallback_method + "|" +
       std::to_string(reference.fallback_samples) + "|" + std::to_string(reference.seed);
   char name[64];
@@ -55,6 +55,7 @@ CachedExactReference exact_reference_for(const Scene& scene, const BatchReferenc
         result.exr = bytes.str();
         result.cached = true;
         result.exact_share = std::atof(metadata["penumbra:exact_share"].c_str());
+        result.fallback_pixel_share = std::atof(metadata["penumbra:fallback_pixel_share"].c_str());
         return result;
       }
     } catch (const std::exception&) {
@@ -70,10 +71,11 @@ CachedExactReference exact_reference_for(const Scene& scene, const BatchReferenc
   ExactReferenceImage image = render_exact_reference(shared, options);
   ImageMetadata metadata = exact_reference_metadata(scene, options, image);
   metadata["cache_key"] = key;
-  result.exr = encode_exr(image.film.color, &image.film.variance, metadata);
+  result.exr = encode_exact_reference(image, metadata);
   result.compute_seconds = image.compute_seconds;
   const double total = double(image.exact_samples + image.fallback_samples);
   result.exact_share = total > 0 ? double(image.exact_samples) / total : 0;
+  result.fallback_pixel_share = image.fallback_pixel_share();
   std::filesystem::create_directories(result.path.parent_path());
   const std::filesystem::path temporary = result.path.string() + ".tmp";
   {

@@ -16,9 +16,10 @@ namespace penumbra {
 struct CachedExactReference {
   std::string exr;  // the EXR bytes (color, variance of the mean, metadata)
   std::filesystem::path path;
-  bool cached = false;         // read from the cache, not rendered now
-  double compute_seconds = 0;  // of the render (when rendered now)
-  double exact_share = 0;      // of camera samples with the closed form
+  bool cached = false;              // read from the cache, not rendered now
+  double compute_seconds = 0;       // of the render (when rendered now)
+  double exact_share = 0;           // of camera samples with the closed form
+  double fallback_pixel_share = 0;  // of pixels with a fallback sample (the exact.mask layer)
 };
 
 // Renders or reads the exact reference of `scene` for the spec's settings. Throws FormatError

@@ -38,6 +38,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(spec.budget_spp[i] >= 1 && spec.budget_spp[i] <= limits.max_spp);
     if (i > 0) FUZZ_CHECK(spec.budget_spp[i - 1] < spec.budget_spp[i]);
   }
+  if (spec.reference.kind == BatchReferenceKind::Auto && spec.reference.sized)
+    FUZZ_CHECK(spec.reference.target_share >= 1e-4 && spec.reference.target_share <= 0.5 &&
+               spec.reference.max_seconds > 0 && spec.reference.max_seconds <= limits.max_seconds);
+  if (spec.reference.kind == BatchReferenceKind::Auto && !spec.reference.sized)
+    FUZZ_CHECK(spec.reference.spp >= 1 && spec.reference.spp <= limits.max_spp);
   FUZZ_CHECK(spec.repeats >= 1 && spec.repeats <= limits.max_repeats);
   FUZZ_CHECK(spec.regions.size() <= limits.max_regions && !spec.regions.count("image"));
   for (const auto& [name, region] : spec.regions)

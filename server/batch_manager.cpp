@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/batch/reference_sizing.h"
 #include "core/image/image.h"
+#include "core/image/noise_corrected_mrse.h"
 #include "core/method/method.h"
 #include "core/method/method_check.h"
 #include "core/scene/json_node.h"
@@ -154,7 +156,8 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
       throw invalid("$.budget.spp: " + std::to_string(spp) +
                     " exceeds the coordinator's limit of " + std::to_string(options_.max_spp) +
                     " passes (in " + source + ")");
-  if (spec.reference.kind == BatchReferenceKind::Auto && spec.reference.spp > options_.max_spp)
+  if (spec.reference.kind == BatchReferenceKind::Auto && !spec.reference.sized &&
+      spec.reference.spp > options_.max_spp)
     throw invalid("$.reference.spp: " + std::to_string(spec.reference.spp) +
                   " exceeds the coordinator's limit of " + std::to_string(options_.max_spp) +
                   " passes (in " + source + ")");
@@ -225,7 +228,20 @@ v1::SubmitBatchResponse BatchManager::submit(const v1::SubmitBatchRequest& reque
     case BatchReferenceKind::Auto:
       reference.set_method(spec.reference.method);
       reference.set_sampler(spec.reference.sampler);
-      reference.set_spp(spec.reference.spp);
+      if (spec.reference.sized) {
+        v1::BatchReferenceSizing& sizing = *reference.mutable_sizing();
+        sizing.set_probe_spp(std::max<uint32_t>(options_.sizing_probe_spp, 2));
+        sizing.set_target_share(spec.reference.target_share);
+        sizing.set_max_seconds(spec.reference.max_seconds);
+        // The reference method must run where the methods do.
+        try {
+          check_method_runs_on(scene, parse_method(spec.reference.method));
+        } catch (const FormatError& error) {
+          throw invalid("$.reference.method: " + std::string(error.what()));
+        }
+      } else {
+        reference.set_spp(spec.reference.spp);
+      }
       break;
   }
 
@@ -413,9 +429,10 @@ bool BatchManager::advance(Batch& batch) {
 
 std::string BatchManager::reference_cache_key(const Batch& batch) const {
   const BatchReferenceSpec& reference = batch.spec.reference;
+  // The status's spp: the spec's, or the sized one.
   return batch.stored.status().scene_hash() + "|" + to_string(parse_method(reference.method)) +
-         "|" + reference.sampler + "|" + std::to_string(reference.spp) + "|" +
-         std::to_string(reference.seed);
+         "|" + reference.sampler + "|" + std::to_string(batch.stored.status().reference().spp()) +
+         "|" + std::to_string(reference.seed);
 }
 
 std::string BatchManager::submit_job(Batch& batch, v1::JobSpec spec, bool in_batch,
@@ -462,6 +479,12 @@ bool BatchManager::advance_reference(Batch& batch) {
   v1::BatchStatus& status = *batch.stored.mutable_status();
   v1::BatchReferenceStatus& reference = *status.mutable_reference();
   bool changed = false;
+  if (reference.kind() == "auto" && reference.job_id().empty() && batch.spec.reference.sized &&
+      !reference.sizing().sized()) {
+    bool sized = false;
+    changed = advance_sizing(batch, sized);
+    if (!sized || is_terminal(status.state())) return changed;
+  }
   if (reference.kind() == "auto" && reference.job_id().empty()) {
     std::string key = reference_cache_key(batch);
     auto cached = reference_cache_.find(key);
@@ -483,14 +506,14 @@ bool BatchManager::advance_reference(Batch& batch) {
       spec.set_method(batch.spec.reference.method);
       spec.set_sampler(batch.spec.reference.sampler);
       spec.set_seed(batch.spec.reference.seed);
-      spec.set_spp(batch.spec.reference.spp);
-      spec.set_passes_per_task(passes_per_task_for(batch.spec.reference.spp, 1));
+      spec.set_spp(reference.spp());
+      spec.set_passes_per_task(passes_per_task_for(reference.spp(), 1));
       spec.set_name("reference for " + status.scene_name() + " (" + status.batch_id() + ")");
       reference.set_job_id(submit_job(batch, spec, false));
       reference_cache_[key] = reference.job_id();
       store_.save_reference_cache(reference_cache_);
       spdlog::info("{}: reference {} submitted ({} at {} spp)", status.batch_id(),
-                   reference.job_id(), batch.spec.reference.method, batch.spec.reference.spp);
+                   reference.job_id(), batch.spec.reference.method, reference.spp());
     }
     changed = true;
   }
@@ -509,6 +532,137 @@ bool BatchManager::advance_reference(Batch& batch) {
   }
   status.set_state(batch.spec.budget_seconds ? v1::BATCH_STATE_CALIBRATING
                                              : v1::BATCH_STATE_RUNNING);
+  return true;
+}
+
+bool BatchManager::advance_sizing(Batch& batch, bool& sized) {
+  v1::BatchStatus& status = *batch.stored.mutable_status();
+  v1::BatchReferenceSizing& sizing = *status.mutable_reference()->mutable_sizing();
+  sized = false;
+  const uint32_t probe_spp = std::max<uint32_t>(sizing.probe_spp(), 2);
+  // Independent of every run (runs use seed + repeat) and of the reference's own seed.
+  const uint64_t probe_seed = batch.spec.reference.seed ^ 0x70726f6265ull;  // "probe"
+  if (sizing.probe_jobs_size() == 0) {
+    auto probe = [&](const std::string& method, const std::string& sampler,
+                     const std::string& label) {
+      v1::JobSpec spec;
+      spec.set_method(method);
+      spec.set_sampler(sampler);
+      spec.set_seed(probe_seed);
+      spec.set_spp(probe_spp);
+      spec.set_passes_per_task(probe_spp);
+      spec.set_name(status.batch_id() + " reference sizing probe: " + label);
+      sizing.add_probe_jobs(submit_job(batch, spec, true));
+    };
+    for (const v1::BatchMethodStatus& method : status.methods())
+      if (method.error().empty()) probe(method.method(), method.sampler(), method.label());
+    probe(batch.spec.reference.method, batch.spec.reference.sampler, "reference");
+    spdlog::info("{}: sizing the reference from {} probes of {} spp", status.batch_id(),
+                 sizing.probe_jobs_size(), probe_spp);
+    store_.save(batch.stored);
+    return true;
+  }
+  std::vector<v1::JobStatus> probes;
+  for (const std::string& job : sizing.probe_jobs()) {
+    probes.push_back(coordinator_.status(job, false));
+    if (!job_terminal(probes.back().state())) return false;
+  }
+  if (probes.back().state() != v1::JOB_STATE_DONE) {
+    fail(batch, "the reference method's sizing probe " + probes.back().job_id() + " ended " +
+                    v1::JobState_Name(probes.back().state()) +
+                    (probes.back().error().empty() ? "" : ": " + probes.back().error()));
+    return true;
+  }
+  // The probes' films; the denominator of every noise term is their mean (all unbiased
+  // estimates of one image, so the mean is the least noisy guess at the truth).
+  std::vector<Film> films(probes.size());
+  std::vector<bool> usable(probes.size(), false);
+  Image denominator;
+  int used = 0;
+  for (size_t i = 0; i < probes.size(); ++i) {
+    if (probes[i].state() != v1::JOB_STATE_DONE || probes[i].passes_complete() == 0) continue;
+    films[i] = coordinator_.result_film(probes[i].job_id());
+    if (films[i].variance.width == 0) continue;
+    usable[i] = true;
+    if (used++ == 0) {
+      denominator = films[i].color;
+    } else {
+      for (size_t k = 0; k < denominator.rgb.size(); ++k)
+        denominator.rgb[k] += films[i].color.rgb[k];
+    }
+  }
+  if (!usable.back()) {
+    fail(batch, "the reference method's sizing probe has no variance layer");
+    return true;
+  }
+  for (float& value : denominator.rgb) value /= float(used);
+  // Each method's spp at the batch's budget: its largest spp level, or what its seconds buy at
+  // the probe's cost per pass, whichever is more.
+  std::vector<double> budget_spp;
+  std::vector<std::string> labels;
+  std::vector<size_t> probe_of;
+  size_t next = 0;
+  for (const v1::BatchMethodStatus& method : status.methods()) {
+    if (!method.error().empty()) continue;
+    const size_t index = next++;
+    if (!usable[index]) continue;
+    double spp = batch.spec.budget_spp.empty() ? 0.0 : double(batch.spec.budget_spp.back());
+    if (batch.spec.budget_seconds && probes[index].compute_seconds() > 0)
+      spp = std::max(spp, *batch.spec.budget_seconds * double(probes[index].passes_complete()) /
+                              probes[index].compute_seconds());
+    budget_spp.push_back(std::max(spp, 1.0));
+    labels.push_back(method.label());
+    probe_of.push_back(index);
+  }
+  const size_t reference_probe = probes.size() - 1;
+  if (labels.empty()) {
+    fail(batch, "no method's sizing probe finished: the reference cannot be sized");
+    return true;
+  }
+  ReferenceSizingRequest request;
+  request.target_share = sizing.target_share();
+  request.max_seconds = sizing.max_seconds();
+  request.max_spp = options_.max_spp;
+  request.seconds_per_pass =
+      probes[reference_probe].compute_seconds() / double(probes[reference_probe].passes_complete());
+  std::vector<std::pair<std::string, Region>> regions = {
+      {"image", Region{0, 0, int(status.width()), int(status.height())}}};
+  for (const v1::BatchRegion& region : status.regions())
+    regions.emplace_back(region.name(), Region{region.rect().x0(), region.rect().y0(),
+                                               region.rect().x1(), region.rect().y1()});
+  for (const auto& [name, rect] : regions) {
+    ReferenceSizingRegion region;
+    region.name = name;
+    const Film& reference_film = films[reference_probe];
+    region.reference_noise = noise_per_sample(
+        reference_film.variance, probes[reference_probe].passes_complete(), denominator, rect);
+    for (size_t m = 0; m < labels.size(); ++m) {
+      const Film& film = films[probe_of[m]];
+      region.expected.push_back(noise_per_sample(film.variance,
+                                                 probes[probe_of[m]].passes_complete(), denominator,
+                                                 rect) /
+                                budget_spp[m]);
+    }
+    request.regions.push_back(std::move(region));
+  }
+  const ReferenceSizing result = size_reference(request);
+  sizing.set_sized(true);
+  sizing.set_seconds_per_pass(request.seconds_per_pass);
+  sizing.set_required_spp(result.required_spp);
+  sizing.set_capped(result.capped);
+  sizing.set_predicted_share(result.predicted_share);
+  sizing.set_predicted_seconds(result.predicted_seconds);
+  sizing.set_deciding_region(result.deciding_region);
+  sizing.set_best_method(result.best_method >= 0 ? labels[size_t(result.best_method)] : "");
+  status.mutable_reference()->set_spp(result.spp);
+  spdlog::info(
+      "{}: reference sized to {} spp (the target asks for {:.0f}; {}predicted share {:.2f}% in "
+      "{}, best method {}; {:.1f} compute s)",
+      status.batch_id(), result.spp, result.required_spp,
+      result.capped ? "capped by max_seconds; " : "", 100 * result.predicted_share,
+      result.deciding_region, sizing.best_method(), result.predicted_seconds);
+  store_.save(batch.stored);
+  sized = true;
   return true;
 }
 
@@ -671,6 +825,8 @@ void BatchManager::cancel_unknown_jobs(const Batch& batch) {
 
 std::vector<std::string> BatchManager::job_ids(const Batch& batch) const {
   std::vector<std::string> ids;
+  for (const std::string& probe : batch.stored.status().reference().sizing().probe_jobs())
+    ids.push_back(probe);
   for (const v1::BatchMethodStatus& method : batch.stored.status().methods()) {
     for (const v1::BatchRun& run : method.runs()) ids.push_back(run.job_id());
     if (!method.calibration_job().empty() &&
@@ -716,6 +872,12 @@ v1::BatchStatus BatchManager::status_locked(const Batch& batch, bool with_curves
       v1::JobStatus job = coordinator_.status(reference.job_id(), false);
       reference.set_state(job.state());
       if (!reference.cached() && reference.kind() == "auto") count(job);
+    } catch (const std::exception&) {
+    }
+  }
+  for (const std::string& probe : reference.sizing().probe_jobs()) {
+    try {
+      count(coordinator_.status(probe, false));
     } catch (const std::exception&) {
     }
   }

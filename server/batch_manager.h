@@ -5,8 +5,10 @@
 //
 // A batch goes through three phases, driven by a background thread:
 //   1. reference: "auto" renders the spec's reference settings as a job, cached by scene hash
-//      and settings (persisted, so a restarted coordinator reuses it too); "job:<id>" waits for
-//      that job; an uploaded EXR is ready at once.
+//      and settings (persisted, so a restarted coordinator reuses it too); with "spp": "auto"
+//      short probes of every method and of the reference method come first, and their noise per
+//      sample sizes the reference (core/batch/reference_sizing.h); "job:<id>" waits for that
+//      job; an uploaded EXR is ready at once.
 //   2. calibration (when the spec has a seconds budget): every run is submitted, per method and
 //      repeat an equal-time job and one job per spp level, all served round-robin on the same
 //      workers (server/scheduler.h), every job against the reference (so the coordinator
@@ -62,6 +64,10 @@ struct BatchManagerOptions {
   std::chrono::milliseconds poll{100};
   BatchLimits limits;
   uint32_t max_spp = 1u << 20;  // of any job (the coordinator's limit)
+  // A sized auto reference ("spp": "auto") is sized from probes of this many passes of every
+  // method and of the reference method (their per-pixel variance per sample and, for the
+  // reference, its cost per pass).
+  uint32_t sizing_probe_spp = 8;
 };
 
 class BatchManager {
@@ -111,6 +117,9 @@ class BatchManager {
   // Moves the batch on as far as its jobs allow; true when it changed (and was saved).
   bool advance(Batch& batch);
   bool advance_reference(Batch& batch);
+  // A sized auto reference: submits the probes, then, once they have ended, sizes the reference
+  // (its spp in the status). True when `changed` something; `sized` says whether it is done.
+  bool advance_sizing(Batch& batch, bool& sized);
   bool advance_calibration(Batch& batch);
   bool advance_runs(Batch& batch);
   bool submit_runs(Batch& batch);

@@ -218,7 +218,8 @@ class BatchSpecParser {
     if (!node.value().is_object())
       node.fail(
           "the reference must be \"auto\", \"job:<id>\", the path of an EXR file or an "
-          "object {\"method\", \"sampler\", \"spp\", \"seed\"}, got " +
+          "object {\"method\", \"sampler\", \"spp\", \"seed\", \"target_share\", "
+          "\"max_seconds\"} or {\"kind\": \"exact\", ...}, got " +
           node.quoted_value());
     if (auto kind = node.optional("kind")) {
       const std::string text = text_value(*kind, "the reference kind");
@@ -229,7 +230,9 @@ class BatchSpecParser {
       if (text != "auto")
         kind->fail("the reference kind must be \"auto\" or \"exact\", got " + kind->quoted_value());
     }
-    node.collect_unknown_keys({"kind", "method", "sampler", "spp", "seed"}, spec_.warnings);
+    node.collect_unknown_keys(
+        {"kind", "method", "sampler", "spp", "seed", "target_share", "max_seconds"},
+        spec_.warnings);
     reference.kind = BatchReferenceKind::Auto;
     if (auto method = node.optional("method")) {
       reference.method = text_value(*method, "the method");
@@ -240,7 +243,39 @@ class BatchSpecParser {
       if (!parse_pattern(reference.sampler))
         sampler->fail("unknown sampler '" + reference.sampler + "'");
     }
-    if (auto spp = node.optional("spp")) reference.spp = spp_value(*spp);
+    if (auto spp = node.optional("spp")) {
+      if (spp->value().is_string()) {
+        if (spp->string() != "auto")
+          spp->fail("the reference's spp must be \"auto\" (sized) or an integer, got " +
+                    spp->quoted_value());
+      } else {
+        reference.spp = spp_value(*spp);
+        reference.sized = false;
+      }
+    }
+    if (auto share = node.optional("target_share")) {
+      if (!reference.sized)
+        share->fail("target_share sizes the reference; it needs \"spp\": \"auto\", not a count");
+      const double value = share->number();
+      if (!(value >= 1e-4) || !(value <= 0.5))
+        share->fail(
+            "target_share must lie in [0.0001, 0.5] (the reference's noise as a share of "
+            "the best method's error), got " +
+            share->quoted_value());
+      reference.target_share = value;
+    }
+    if (auto seconds = node.optional("max_seconds")) {
+      if (!reference.sized)
+        seconds->fail("max_seconds caps a sized reference; it needs \"spp\": \"auto\"");
+      const double value = seconds->number();
+      if (!(value > 0) || !(value <= limits_.max_seconds))
+        seconds->fail(
+            "max_seconds (compute seconds for the reference) must be positive and at "
+            "most " +
+            number_text(limits_.max_seconds) + " (limit max_seconds), got " +
+            seconds->quoted_value());
+      reference.max_seconds = value;
+    }
     if (auto seed = node.optional("seed")) {
       int64_t value = seed->integer();
       if (value < 0)

@@ -9,6 +9,7 @@
 //    "methods": [{"method": "line-sa:v", "sampler": "stratified", "label": "ours"}, "sa"],
 //    "budget": {"seconds": 10, "spp": [16, 64]},
 //    "reference": "auto",  // or "job:job-7", "path/to/ref.exr", {"method":..,"spp":..},
+//                          // {"spp": "auto", "target_share": 0.01, "max_seconds": 300},
 //                          // {"kind": "exact", "camera_samples": 16}
 //    "regions": {"penumbra": [120, 300, 220, 400]}, "seed": 1, "repeats": 3}
 
@@ -33,7 +34,7 @@ struct BatchLimits {
   size_t max_methods = 64;
   size_t max_spp_levels = 32;   // entries of budget.spp
   uint32_t max_spp = 1u << 20;  // each spp level and the reference's spp
-  double max_seconds = 1e6;     // budget.seconds (per method and repeat)
+  double max_seconds = 1e6;     // budget.seconds (per method and repeat), reference.max_seconds
   uint32_t max_repeats = 100;
   size_t max_regions = 64;
   size_t max_text_length = 1024;     // names, labels, methods, samplers, paths
@@ -47,9 +48,12 @@ struct BatchMethodSpec {
 };
 
 enum class BatchReferenceKind {
-  Auto,  // rendered by the farm with a robust method at high spp, cached by scene and settings
-  Exr,   // an EXR file the client uploads
-  Job,   // the result of a finished job on the same coordinator
+  // Rendered by the farm with a robust method, cached by scene and settings; its spp given, or
+  // sized from short probes of every method and of the reference method (core/batch/
+  // reference_sizing.h) so that its noise is a small share of the best method's error.
+  Auto,
+  Exr,  // an EXR file the client uploads
+  Job,  // the result of a finished job on the same coordinator
   // Closed-form direct illumination per camera sample (core/exact), rendered by the client
   // (cached by scene hash, build flavour and settings) and uploaded like an EXR; pixels without
   // a closed form fall back to a converged estimate.
@@ -63,8 +67,15 @@ struct BatchReferenceSpec {
   // Auto: what renders the reference.
   std::string method = "bsdf+sa";
   std::string sampler = "stratified";
-  uint32_t spp = 1024;
+  uint32_t spp = 1024;  // when not sized
   uint64_t seed = 0x5eed;
+  // Auto with "spp": "auto" (the default): spp sized so that the reference's expected noise term
+  // is at most target_share of the best method's expected MRSE at the batch's budget, in the
+  // image and every region, unless rendering that many passes would take more than max_seconds
+  // compute seconds (then the cap decides, and the report says so).
+  bool sized = true;
+  double target_share = 0.01;
+  double max_seconds = 300;
   // Exact: camera rays per pixel, and the fallback where no closed form applies (method, and
   // samples per term for each camera sample).
   uint32_t camera_samples = 16;

@@ -2,7 +2,8 @@
 // `penumbra exact SCENE PROBE`: the exact reflected radiance at a probe's pixels and points
 // (penumbra/probe@1, SCENE_FORMAT.md), where the closed form applies, else the fallback estimate:
 //   {"format": "penumbra/exact-result@1", "fallback": {"method": ..., "samples": ...},
-//    "points": [{"index": i, "radiance": [r, g, b], "exact": true}, ...]}
+//    "points": [{"index": i, "radiance": [r, g, b], "exact": true}, ...],
+//    "exact_share": 0.75, "fallback_points": 2}
 // pixels first, then points, in input order (as penumbra/probe-result@1 numbers them).
 
 #include <memory>

@@ -104,6 +104,25 @@ ExactReferenceImage render_exact_reference(std::shared_ptr<const Scene> scene,
   return result;
 }
 
+std::vector<float> ExactReferenceImage::fallback_mask() const {
+  std::vector<float> mask(size_t(exact_fraction.width) * exact_fraction.height);
+  for (size_t i = 0; i < mask.size(); ++i) mask[i] = 1.0f - exact_fraction.rgb[3 * i];
+  return mask;
+}
+
+double ExactReferenceImage::fallback_pixel_share() const {
+  const size_t pixels = size_t(exact_fraction.width) * exact_fraction.height;
+  size_t marked = 0;
+  for (size_t i = 0; i < pixels; ++i) marked += exact_fraction.rgb[3 * i] < 1.0f ? 1 : 0;
+  return pixels > 0 ? double(marked) / double(pixels) : 0.0;
+}
+
+std::string encode_exact_reference(const ExactReferenceImage& image,
+                                   const ImageMetadata& metadata) {
+  return encode_exr(image.film.color, &image.film.variance, metadata,
+                    {ExrChannel{kExactMaskChannel, image.fallback_mask()}});
+}
+
 ImageMetadata exact_reference_metadata(const Scene& scene, const ExactReferenceOptions& options,
                                        const ExactReferenceImage& image) {
   ImageMetadata metadata;
@@ -118,6 +137,8 @@ ImageMetadata exact_reference_metadata(const Scene& scene, const ExactReferenceO
   metadata["compute_seconds"] = std::to_string(image.compute_seconds);
   const double total = double(image.exact_samples + image.fallback_samples);
   metadata["exact_share"] = std::to_string(total > 0 ? double(image.exact_samples) / total : 0.0);
+  metadata["fallback_pixel_share"] = std::to_string(image.fallback_pixel_share());
+  metadata["mask_channel"] = kExactMaskChannel;
   metadata["build_flavour"] = kBuildFlavour;
   return metadata;
 }

@@ -9,6 +9,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "core/exact/exact_shading.h"
 #include "core/image/image.h"
@@ -23,9 +25,18 @@ struct ExactReferenceOptions {
   int threads = 0;  // 0: all
 };
 
+// The EXR channel of an exact reference that marks where the closed form did not apply: per
+// pixel, the share of its camera samples shaded by the fallback (0: exact up to antialiasing, 1:
+// every sample a converged estimate).
+inline constexpr const char* kExactMaskChannel = "exact.mask";
+
 struct ExactReferenceImage {
   Film film;
   Image exact_fraction;  // per pixel, in all three channels
+  // The exact.mask channel: 1 - exact_fraction per pixel.
+  std::vector<float> fallback_mask() const;
+  // Share of the pixels with any fallback sample (mask > 0).
+  double fallback_pixel_share() const;
   uint64_t exact_samples = 0, fallback_samples = 0;
   VisibleLightStats stats;
   double compute_seconds = 0, wall_seconds = 0;
@@ -35,8 +46,13 @@ struct ExactReferenceImage {
 ExactReferenceImage render_exact_reference(std::shared_ptr<const Scene> scene,
                                            const ExactReferenceOptions& options = {});
 
-// EXR metadata of an exact reference ("penumbra:method" = "exact", the fallback, counts).
+// EXR metadata of an exact reference ("penumbra:method" = "exact", the fallback, counts, the
+// shares of exact camera samples and of pixels with a fallback sample).
 ImageMetadata exact_reference_metadata(const Scene& scene, const ExactReferenceOptions& options,
                                        const ExactReferenceImage& image);
+
+// The EXR of an exact reference: color, variance of the mean, the exact.mask channel and
+// `metadata`.
+std::string encode_exact_reference(const ExactReferenceImage& image, const ImageMetadata& metadata);
 
 }  // namespace penumbra

@@ -58,7 +58,7 @@ void check_image_shape(const Image& image, const std::string& what, const std::s
 // The interleaved float pixels of an EXR with R,G,B and optionally variance.R/G/B, and its
 // metadata as string attributes.
 oiio::Pixels exr_contents(const Image& color, const Image* variance, const ImageMetadata& metadata,
-                          const std::string& where) {
+                          const std::vector<ExrChannel>& extra, const std::string& where) {
   // Check the images.
   check_image_shape(color, "color", where);
   if (variance) {
@@ -69,8 +69,20 @@ oiio::Pixels exr_contents(const Image& color, const Image* variance, const Image
                                std::to_string(color.width) + "x" + std::to_string(color.height));
   }
 
+  const size_t pixel_count = size_t(color.width) * size_t(color.height);
+  for (const ExrChannel& channel : extra) {
+    if (channel.values.size() != pixel_count)
+      throw std::runtime_error(where + ": channel " + channel.name + " holds " +
+                               std::to_string(channel.values.size()) + " values, expected " +
+                               std::to_string(pixel_count));
+    if (channel.name.empty() || channel.name == "R" || channel.name == "G" || channel.name == "B" ||
+        channel.name.rfind("variance.", 0) == 0)
+      throw std::runtime_error(where + ": channel name '" + channel.name + "' is taken");
+  }
+
   // Describe the channels and the metadata.
-  int channel_count = variance ? 6 : 3;
+  const int base_channels = variance ? 6 : 3;
+  const int channel_count = base_channels + int(extra.size());
   oiio::Pixels contents;
   contents.width = color.width;
   contents.height = color.height;
@@ -78,17 +90,18 @@ oiio::Pixels exr_contents(const Image& color, const Image* variance, const Image
   for (const char* name : kColorChannels) contents.channel_names.emplace_back(name);
   if (variance)
     for (const char* name : kVarianceChannels) contents.channel_names.emplace_back(name);
+  for (const ExrChannel& channel : extra) contents.channel_names.push_back(channel.name);
   for (const auto& [key, value] : metadata)
     contents.strings.emplace_back(metadata_attribute_name(key), value);
 
   // Interleave the pixels.
-  size_t pixel_count = size_t(color.width) * size_t(color.height);
   contents.data.resize(pixel_count * channel_count);
   for (size_t p = 0; p < pixel_count; ++p) {
     float* out = &contents.data[p * channel_count];
     for (int c = 0; c < 3; ++c) out[c] = color.rgb[p * 3 + c];
     if (variance)
       for (int c = 0; c < 3; ++c) out[3 + c] = variance->rgb[p * 3 + c];
+    for (size_t k = 0; k < extra.size(); ++k) out[base_channels + int(k)] = extra[k].values[p];
   }
   return contents;
 }
@@ -168,8 +181,9 @@ namespace {
 
 // Encodes to memory; `where` names the destination in errors.
 std::string encode_exr_for(const std::string& where, const Image& color, const Image* variance,
-                           const ImageMetadata& metadata, ExrPixelType pixel_type) {
-  oiio::Pixels contents = exr_contents(color, variance, metadata, where);
+                           const ImageMetadata& metadata, const std::vector<ExrChannel>& extra,
+                           ExrPixelType pixel_type) {
+  oiio::Pixels contents = exr_contents(color, variance, metadata, extra, where);
   return in_module(where, [&](const oiio::Services& services) {
     return services.encode_exr(contents, pixel_type == ExrPixelType::Half);
   });
@@ -206,13 +220,25 @@ void write_file_atomically(const std::string& path, const std::string& bytes,
 
 void write_exr(const std::string& path, const Image& color, const Image* variance,
                const ImageMetadata& metadata, ExrPixelType pixel_type) {
+  write_exr(path, color, variance, metadata, {}, pixel_type);
+}
+
+void write_exr(const std::string& path, const Image& color, const Image* variance,
+               const ImageMetadata& metadata, const std::vector<ExrChannel>& extra,
+               ExrPixelType pixel_type) {
   std::string where = "EXR '" + path + "'";
-  write_file_atomically(path, encode_exr_for(where, color, variance, metadata, pixel_type), where);
+  write_file_atomically(path, encode_exr_for(where, color, variance, metadata, extra, pixel_type),
+                        where);
 }
 
 std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata,
                        ExrPixelType pixel_type) {
-  return encode_exr_for("EXR encoding", color, variance, metadata, pixel_type);
+  return encode_exr_for("EXR encoding", color, variance, metadata, {}, pixel_type);
+}
+
+std::string encode_exr(const Image& color, const Image* variance, const ImageMetadata& metadata,
+                       const std::vector<ExrChannel>& extra, ExrPixelType pixel_type) {
+  return encode_exr_for("EXR encoding", color, variance, metadata, extra, pixel_type);
 }
 
 Image read_exr(const std::string& path, ImageMetadata* metadata, Image* variance) {
@@ -269,6 +295,36 @@ std::string encode_png_preview(const Image& color, double exposure) {
 void write_png_preview(const std::string& path, const Image& color, double exposure) {
   std::string where = "PNG '" + path + "'";
   write_file_atomically(path, encode_png_for(where, color, exposure), where);
+}
+
+namespace {
+
+std::vector<float> channel_of(const oiio::Pixels& pixels, const std::string& name) {
+  const int index = find_channel(pixels, name);
+  if (index < 0) return {};
+  const size_t pixel_count = size_t(pixels.width) * size_t(pixels.height);
+  std::vector<float> values(pixel_count);
+  for (size_t p = 0; p < pixel_count; ++p)
+    values[p] = pixels.data[p * size_t(pixels.channels) + size_t(index)];
+  return values;
+}
+
+}  // namespace
+
+std::vector<float> read_exr_channel(const std::string& path, const std::string& name) {
+  std::string where = "EXR '" + path + "'";
+  oiio::Pixels pixels = in_module(where, [&](const oiio::Services& services) {
+    return services.read_exr(path, /*from_memory=*/false, kMaxImageSide, kMaxChannels);
+  });
+  return channel_of(pixels, name);
+}
+
+std::vector<float> decode_exr_channel(const std::string& bytes, const std::string& name) {
+  std::string where = "EXR bytes (" + std::to_string(bytes.size()) + " bytes)";
+  oiio::Pixels pixels = in_module(where, [&](const oiio::Services& services) {
+    return services.read_exr(bytes, /*from_memory=*/true, kMaxImageSide, kMaxChannels);
+  });
+  return channel_of(pixels, name);
 }
 
 }  // namespace penumbra

@@ -103,4 +103,11 @@ double reference_noise_mrse(const Image& reference, const Image& reference_varia
       .reference_term;
 }
 
+double noise_per_sample(const Image& variance, uint32_t spp, const Image& denominator,
+                        const Region& region, double epsilon) {
+  // The variance takes the reference's place in noise_corrected_mrse's reference term.
+  if (variance.width == 0) throw std::invalid_argument("noise per sample: no variance layer");
+  return double(spp) * reference_noise_mrse(denominator, variance, region, epsilon);
+}
+
 }  // namespace penumbra

@@ -40,6 +40,7 @@
 // pixels as independent. Paired comparisons of two methods against the same reference do not
 // see it: it is the same number in both.
 
+#include <cstdint>
 #include <map>
 #include <string>
 
@@ -82,5 +83,14 @@ std::map<std::string, NoiseCorrectedError> noise_corrected_summary(
 // region: what `reference_term` is for any test image. Used to size a reference.
 double reference_noise_mrse(const Image& reference, const Image& reference_variance,
                             const Region& region, double epsilon = kMrseEpsilon);
+
+// An estimator's noise per sample over the region: mean over pixels and channels of
+// spp * variance(p) / (denominator(p)^2 + eps), `variance` its EXR's variance of the mean at
+// `spp` samples per pixel and `denominator` an estimate of the true image (the same for every
+// estimator compared, so that their ratios do not depend on its noise). Its expected MRSE at N
+// samples per pixel is this over N (core/batch/reference_sizing.h). Throws
+// std::invalid_argument like noise_corrected_mrse.
+double noise_per_sample(const Image& variance, uint32_t spp, const Image& denominator,
+                        const Region& region, double epsilon = kMrseEpsilon);
 
 }  // namespace penumbra

@@ -73,6 +73,25 @@ ReferenceNoise read_reference_noise(const BatchResult& result,
   } catch (const std::invalid_argument& error) {
     throw std::runtime_error(path.string() + ": " + error.what());
   }
+  const std::vector<float> mask = read_exr_channel(path.string(), "exact.mask");
+  if (!mask.empty()) {
+    std::map<std::string, Region> regions = result.region_map();
+    regions["image"] = Region{0, 0, reference.width, reference.height};
+    for (const auto& [name, region] : regions) {
+      const Region area = clip_region(region, reference);
+      ReferenceNoise::MaskShare share;
+      for (int y = area.y0; y < area.y1; ++y)
+        for (int x = area.x0; x < area.x1; ++x) {
+          const float m = mask[size_t(y) * reference.width + x];
+          share.pixels += m > 0 ? 1 : 0;
+          share.samples += m;
+        }
+      const double count = double(area.x1 - area.x0) * double(area.y1 - area.y0);
+      share.pixels /= count;
+      share.samples /= count;
+      noise.fallback[name] = share;
+    }
+  }
   return noise;
 }
 
@@ -241,6 +260,9 @@ void add_comparison_json(nlohmann::json& table_json, const BatchTable& table,
   for (const auto& [region, error] : noise.regions)
     reference["regions"][region] = {{"term", error.reference_term},
                                     {"deviation", error.reference_deviation}};
+  for (const auto& [region, share] : noise.fallback)
+    reference["fallback"][region] = {{"pixel_share", share.pixels},
+                                     {"sample_share", share.samples}};
   table_json["reference_noise"] = reference;
   nlohmann::json pairwise = nlohmann::json::array();
   for (const PairwiseComparison& pair : comparison.pairwise)

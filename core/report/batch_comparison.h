@@ -31,6 +31,13 @@ inline constexpr double kReferenceShareFlag = 0.10;
 struct ReferenceNoise {
   bool has_variance = false;  // the reference EXR has a variance layer
   std::map<std::string, NoiseCorrectedError> regions;
+  // An exact reference's exact.mask channel (core/exact/exact_reference.h: per pixel the share
+  // of camera samples the fallback shaded), summarised per region: the share of pixels with a
+  // fallback sample, and the mean mask (the share of camera samples). Empty without the channel.
+  struct MaskShare {
+    double pixels = 0, samples = 0;
+  };
+  std::map<std::string, MaskShare> fallback;
   // The plain MRSE of a run (or curve point) in `region` with the reference's term removed.
   double corrected(const std::string& region, double plain) const;
   double term(const std::string& region) const;

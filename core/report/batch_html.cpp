@@ -269,6 +269,7 @@ std::string batch_report_html(const BatchReportContent& content) {
   detail("method", result.reference.method);
   detail("sampler", result.reference.sampler);
   detail("spp", std::to_string(result.reference.spp));
+  if (result.reference.sizing) detail("sized", reference_sizing_text(result.reference));
   detail("job", result.reference.job_id);
   detail("cached", result.reference.cached ? "yes (rendered by an earlier batch)" : "no");
   if (content.reference_noise) {
@@ -280,6 +281,14 @@ std::string batch_report_html(const BatchReportContent& content) {
         detail("own MRSE, " + region, format_number(error.reference_term) + " (± " +
                                           format_number(error.reference_deviation) +
                                           " shared by every run)");
+    }
+    for (const auto& [region, share] : noise.fallback) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "%.1f%% of the pixels have a camera sample without a closed form (%.1f%% of "
+                    "the camera samples), shaded by the fallback estimate (the EXR's exact.mask)",
+                    100 * share.pixels, 100 * share.samples);
+      detail("not exact, " + region, text);
     }
   }
   out << "</table>\n";

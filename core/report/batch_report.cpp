@@ -133,6 +133,17 @@ void write_batch_report(const std::filesystem::path& result_dir,
   write_text_file(out_dir / "table.csv", batch_table_csv(table));
   nlohmann::json table_json = batch_table_json(table);
   add_comparison_json(table_json, table, comparison, noise);
+  if (result.reference.sizing) {
+    const BatchReferenceSizing& sizing = *result.reference.sizing;
+    table_json["reference_sizing"] = {{"spp", result.reference.spp},
+                                      {"required_spp", sizing.required_spp},
+                                      {"capped", sizing.capped},
+                                      {"target_share", sizing.target_share},
+                                      {"max_seconds", sizing.max_seconds},
+                                      {"predicted_share", sizing.predicted_share},
+                                      {"deciding_region", sizing.deciding_region},
+                                      {"text", reference_sizing_text(result.reference)}};
+  }
   write_text_file(out_dir / "table.json", table_json.dump(2) + "\n");
 
   BatchReportContent content;

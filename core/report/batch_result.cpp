@@ -106,8 +106,10 @@ ErrorSummary parse_error_entry(const KeyNode& node) {
   return summary;
 }
 
-BatchRun parse_run(const KeyNode& node) {
+BatchRun parse_run(const KeyNode& node, bool budgeted) {
   BatchRun run;
+  run.equal_time = budgeted;
+  if (auto equal_time = node.optional("equal_time")) run.equal_time = equal_time->boolean();
   run.repeat = int(node.required("repeat").integer(0, 1 << 20));
   run.seed = node.required("seed").unsigned_integer();
   if (auto job = node.optional("job_id")) run.job_id = job->string();
@@ -147,7 +149,8 @@ BatchMethod parse_method(const KeyNode& node) {
   if (auto budget = node.optional("budget_seconds")) method.budget_seconds = budget->non_negative();
   if (auto error = node.optional("error")) method.error = error->string();
   KeyNode runs = node.required("runs");
-  for (size_t i = 0; i < runs.size(); ++i) method.runs.push_back(parse_run(runs.at(i)));
+  for (size_t i = 0; i < runs.size(); ++i)
+    method.runs.push_back(parse_run(runs.at(i), method.budget_seconds.has_value()));
   return method;
 }
 
@@ -216,6 +219,21 @@ BatchResult parse_batch_result(const std::string& json_text, const std::string& 
     result.reference.spp = uint32_t(spp->integer(0, kMaxSpp - 1));
   if (auto job = reference.optional("job_id")) result.reference.job_id = job->string();
   if (auto cached = reference.optional("cached")) result.reference.cached = cached->boolean();
+  if (auto kind = reference.optional("kind")) result.reference.kind = kind->string();
+  if (auto node = reference.optional("sizing")) {
+    BatchReferenceSizing sizing;
+    sizing.probe_spp = uint32_t(node->required("probe_spp").integer(0, kMaxSpp - 1));
+    sizing.target_share = node->required("target_share").non_negative();
+    sizing.max_seconds = node->required("max_seconds").non_negative();
+    sizing.seconds_per_pass = node->required("seconds_per_pass").non_negative();
+    sizing.required_spp = node->required("required_spp").non_negative();
+    sizing.capped = node->required("capped").boolean();
+    sizing.predicted_share = node->required("predicted_share").non_negative();
+    sizing.predicted_seconds = node->required("predicted_seconds").non_negative();
+    sizing.deciding_region = node->required("deciding_region").string();
+    sizing.best_method = node->required("best_method").string();
+    result.reference.sizing = sizing;
+  }
 
   KeyNode methods = root.required("methods");
   for (size_t i = 0; i < methods.size(); ++i) {
@@ -273,6 +291,8 @@ std::string reference_depth_warning(const BatchResult& result) {
   const BatchReference& reference = result.reference;
   // An exact reference's spp counts camera samples of closed-form shading, not noisy passes.
   if (reference.spp == 0 || reference.method.rfind("exact", 0) == 0) return "";
+  // A sized reference was sized by its noise, which is what this rule of thumb stands in for.
+  if (reference.sizing) return "";
   uint32_t deepest = 0;
   std::string label;
   for (const BatchMethod& method : result.methods)
@@ -289,6 +309,30 @@ std::string reference_depth_warning(const BatchResult& result) {
          "'s runs: it is barely cleaner than what it judges, and its noise is a large part of "
          "every error (give the reference " +
          std::to_string(uint32_t(kReferenceSppFactor) * deepest) + " spp or more)";
+}
+
+std::string reference_sizing_text(const BatchReference& reference) {
+  if (!reference.sizing) return "";
+  const BatchReferenceSizing& sizing = *reference.sizing;
+  char text[512];
+  if (sizing.capped)
+    std::snprintf(text, sizeof text,
+                  "sized from %u-spp probes: %u spp, capped by max_seconds = %g compute s (the "
+                  "%g%% target asked for %.0f spp); predicted reference share %.2f%% in \"%s\" "
+                  "(best method there: %s)",
+                  sizing.probe_spp, reference.spp, sizing.max_seconds, 100 * sizing.target_share,
+                  std::ceil(sizing.required_spp), 100 * sizing.predicted_share,
+                  sizing.deciding_region.c_str(), sizing.best_method.c_str());
+  else
+    std::snprintf(text, sizeof text,
+                  "sized from %u-spp probes: %u spp for a %g%% target (%.0f asked for, rounded up "
+                  "to a quarter octave; cap max_seconds = %g not reached, %.1f compute s "
+                  "predicted); predicted reference share %.2f%% in \"%s\" (best method there: %s)",
+                  sizing.probe_spp, reference.spp, 100 * sizing.target_share,
+                  std::ceil(sizing.required_spp), sizing.max_seconds, sizing.predicted_seconds,
+                  100 * sizing.predicted_share, sizing.deciding_region.c_str(),
+                  sizing.best_method.c_str());
+  return text;
 }
 
 }  // namespace penumbra

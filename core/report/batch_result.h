@@ -45,6 +45,9 @@ struct BatchRun {
   std::string job_id;
   std::string exr;  // relative to the result folder, e.g. "runs/line-sa_v.r0.exr"
   uint32_t spp = 0;
+  // The method's equal-time run (its budget in seconds), else a run of a fixed spp level. When
+  // batch.json does not say: equal time exactly when the method has a seconds budget.
+  bool equal_time = false;
   double compute_seconds = 0;
   double wall_seconds = 0;
   std::vector<BatchCurvePoint> curve;
@@ -61,13 +64,29 @@ struct BatchMethod {
   std::string error;  // the farm's refusal message (then runs is empty); empty when it ran
 };
 
+// How a sized auto reference ("spp": "auto") chose its spp (core/batch/reference_sizing.h).
+struct BatchReferenceSizing {
+  uint32_t probe_spp = 0;
+  double target_share = 0;
+  double max_seconds = 0;
+  double seconds_per_pass = 0;
+  double required_spp = 0;  // what the target asked for
+  bool capped = false;      // max_seconds bound: fewer spp than the target asked for
+  double predicted_share = 0;
+  double predicted_seconds = 0;
+  std::string deciding_region;
+  std::string best_method;
+};
+
 struct BatchReference {
-  std::string exr;  // relative to the result folder
+  std::string exr;   // relative to the result folder
+  std::string kind;  // "auto", "job", "exr", "exact" (empty in older folders)
   std::string method;
   std::string sampler;
   uint32_t spp = 0;
   std::string job_id;
   bool cached = false;
+  std::optional<BatchReferenceSizing> sizing;
 };
 
 struct BatchSceneInfo {
@@ -105,6 +124,10 @@ BatchResult parse_batch_result(const std::string& json_text,
 // one, or its spp is unknown).
 inline constexpr double kReferenceSppFactor = 4;
 std::string reference_depth_warning(const BatchResult& result);
+
+// One sentence on how a sized reference chose its spp: the spp, what the target asked for,
+// whether max_seconds bound, the predicted reference share and where.
+std::string reference_sizing_text(const BatchReference& reference);
 
 // Reads DIR/batch.json and checks that every EXR it names exists in DIR (a missing file is an
 // error naming the key path and the file). Throws BatchResultError.

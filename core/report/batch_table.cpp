@@ -127,12 +127,14 @@ BatchTable make_batch_table(const BatchResult& result, const RecomputedErrors& r
       table.rows.push_back(base);
       continue;
     }
-    // Group the runs: all of a budgeted method together, else one group per spp level.
+    // Group the runs: a budgeted method's equal-time runs together (key 0), and one group per
+    // spp level.
     std::map<uint32_t, std::vector<size_t>> groups;
     for (size_t r = 0; r < method.runs.size(); ++r)
-      groups[method.budget_seconds ? 0u : method.runs[r].spp].push_back(r);
+      groups[method.runs[r].equal_time ? 0u : method.runs[r].spp].push_back(r);
     for (const auto& [spp_key, run_indices] : groups) {
       BatchTableRow row = base;
+      if (spp_key != 0) row.budget_seconds.reset();  // an spp level of a budgeted method
       row.run_indices = run_indices;
       row.repeats = int(run_indices.size());
       row.spp_min = UINT32_MAX;
@@ -148,8 +150,8 @@ BatchTable make_batch_table(const BatchResult& result, const RecomputedErrors& r
       }
       row.compute_seconds = mean_std(seconds);
       for (const std::string& region : table.regions) row.mrse[region] = mean_std(errors[region]);
-      row.comparison_group = method.budget_seconds
-                                 ? "budget " + format_number(*method.budget_seconds) + " s"
+      row.comparison_group = row.budget_seconds
+                                 ? "budget " + format_number(*row.budget_seconds) + " s"
                                  : std::to_string(spp_key) + " spp";
       table.rows.push_back(std::move(row));
     }

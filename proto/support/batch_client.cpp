@@ -236,6 +236,19 @@ void write_batch_result(BatchClient& client, const v1::BatchStatus& status,
   index["reference"] = {{"exr", "reference.exr"},   {"kind", ref.kind()}, {"method", ref.method()},
                         {"sampler", ref.sampler()}, {"spp", ref.spp()},   {"job_id", ref.job_id()},
                         {"cached", ref.cached()}};
+  if (ref.sizing().sized()) {
+    const v1::BatchReferenceSizing& sizing = ref.sizing();
+    index["reference"]["sizing"] = {{"probe_spp", sizing.probe_spp()},
+                                    {"target_share", sizing.target_share()},
+                                    {"max_seconds", sizing.max_seconds()},
+                                    {"seconds_per_pass", sizing.seconds_per_pass()},
+                                    {"required_spp", sizing.required_spp()},
+                                    {"capped", sizing.capped()},
+                                    {"predicted_share", sizing.predicted_share()},
+                                    {"predicted_seconds", sizing.predicted_seconds()},
+                                    {"deciding_region", sizing.deciding_region()},
+                                    {"best_method", sizing.best_method()}};
+  }
   index["wall_seconds"] = status.wall_seconds();
   index["compute_seconds"] = status.compute_seconds();
 

@@ -43,6 +43,7 @@ TEST(BatchSpec, ReadsEveryField) {
   EXPECT_EQ(spec.budget_spp, (std::vector<uint32_t>{16, 64}));  // sorted, distinct
   EXPECT_EQ(spec.reference.kind, BatchReferenceKind::Auto);
   EXPECT_EQ(spec.reference.spp, 256u);
+  EXPECT_FALSE(spec.reference.sized) << "a given spp is not sized";
   EXPECT_EQ(spec.reference.seed, 9u);
   ASSERT_EQ(spec.regions.count("penumbra"), 1u);
   EXPECT_EQ(spec.regions.at("penumbra").x1, 30);
@@ -62,6 +63,9 @@ TEST(BatchSpec, DefaultsAndReferenceForms) {
   EXPECT_FALSE(spec.budget_seconds.has_value());
   EXPECT_EQ(spec.reference.kind, BatchReferenceKind::Auto);
   EXPECT_EQ(spec.reference.method, "bsdf+sa");
+  EXPECT_TRUE(spec.reference.sized) << "the default reference is sized";
+  EXPECT_DOUBLE_EQ(spec.reference.target_share, 0.01);
+  EXPECT_DOUBLE_EQ(spec.reference.max_seconds, 300);
   EXPECT_EQ(spec.seed, 1u);
   EXPECT_EQ(spec.repeats, 3u);  // intervals need repeats: three by default
 
@@ -73,6 +77,19 @@ TEST(BatchSpec, DefaultsAndReferenceForms) {
   BatchSpec job = parse_batch_spec(with_reference(R"("job:job-7")"), "b");
   EXPECT_EQ(job.reference.kind, BatchReferenceKind::Job);
   EXPECT_EQ(job.reference.job_id, "job-7");
+  BatchSpec sized = parse_batch_spec(with_reference(R"("auto")"), "b");
+  EXPECT_EQ(sized.reference.kind, BatchReferenceKind::Auto);
+  EXPECT_TRUE(sized.reference.sized);
+  BatchSpec tuned = parse_batch_spec(
+      with_reference(R"({"method": "sa", "spp": "auto", "target_share": 0.05, "max_seconds": 20})"),
+      "b");
+  EXPECT_TRUE(tuned.reference.sized);
+  EXPECT_EQ(tuned.reference.method, "sa");
+  EXPECT_DOUBLE_EQ(tuned.reference.target_share, 0.05);
+  EXPECT_DOUBLE_EQ(tuned.reference.max_seconds, 20);
+  BatchSpec unsized = parse_batch_spec(with_reference(R"({"spp": 64})"), "b");
+  EXPECT_FALSE(unsized.reference.sized);
+  EXPECT_EQ(unsized.reference.spp, 64u);
   BatchSpec exr = parse_batch_spec(with_reference(R"("refs/ref.exr")"), "b");
   EXPECT_EQ(exr.reference.kind, BatchReferenceKind::Exr);
   EXPECT_EQ(exr.reference.exr_path, "refs/ref.exr");
@@ -142,6 +159,18 @@ TEST(BatchSpec, EveryErrorNamesItsField) {
       {spec_with("reference", R"("job:")"), "$.reference", "job id"},
       {spec_with("reference", R"({"spp": -4})"), "$.reference.spp", "spp"},
       {spec_with("reference", R"({"method": "bogus"})"), "$.reference.method", "not a method"},
+      {spec_with("reference", R"({"spp": "many"})"), "$.reference.spp", "\"auto\""},
+      {spec_with("reference", R"({"spp": "auto", "target_share": 0})"), "$.reference.target_share",
+       "[0.0001, 0.5]"},
+      {spec_with("reference", R"({"target_share": 0.9})"), "$.reference.target_share",
+       "[0.0001, 0.5]"},
+      {spec_with("reference", R"({"target_share": "1%"})"), "$.reference.target_share", "number"},
+      {spec_with("reference", R"({"spp": 64, "target_share": 0.01})"), "$.reference.target_share",
+       "needs \"spp\": \"auto\""},
+      {spec_with("reference", R"({"max_seconds": -5})"), "$.reference.max_seconds", "positive"},
+      {spec_with("reference", R"({"max_seconds": 1e7})"), "$.reference.max_seconds", "max_seconds"},
+      {spec_with("reference", R"({"spp": 16, "max_seconds": 10})"), "$.reference.max_seconds",
+       "caps a sized reference"},
       {spec_with("regions", R"({"image": [0, 0, 1, 1]})"), "$.regions.image", "whole image"},
       {spec_with("regions", R"({"a": [0, 0, 1]})"), "$.regions.a", "[x0, y0, x1, y1]"},
       {spec_with("regions", R"({"a": [5, 0, 1, 1]})"), "$.regions.a", "empty region"},

@@ -319,6 +319,15 @@ batch_case("too-many-methods", batch_with(setter(["methods"], [{"method": "sa", 
            "$.methods", why="65 methods")
 batch_case("missing-budget", batch_with(deleter(["budget"])), "$.budget: missing required key",
            why="no budget")
+batch_case("reference-spp-word", batch_with(setter(["reference"], {"spp": "lots"})),
+           "$.reference.spp", why="a sized reference is \"spp\": \"auto\", not another word")
+batch_case("reference-share-zero", batch_with(setter(["reference"], {"target_share": 0})),
+           "$.reference.target_share", why="a reference share of zero needs infinite samples")
+batch_case("reference-share-with-spp",
+           batch_with(setter(["reference"], {"spp": 64, "target_share": 0.01})),
+           "$.reference.target_share", why="a share sizes the reference; a given spp is not sized")
+batch_case("reference-cap-negative", batch_with(setter(["reference"], {"max_seconds": -1})),
+           "$.reference.max_seconds", why="a negative compute cap")
 
 
 # Requests: one RPC each, in protobuf text format (`rpc:` names the method; SubmitJob by default;
