@@ -5,13 +5,13 @@
 # + LeakSanitizer, two at a time, each counted as one test. Ends with one line
 # "N passed, N failed". Installs what it needs first (Debian 12, as root).
 #   PENUMBRA_SKIP_SANITIZE=1  skip the sanitizer pass and the fuzzing (quick local runs)
-#   PENUMBRA_FUZZ_SECONDS=N   seconds per fuzz target (default 30; 0 skips the fuzzing)
+#   PENUMBRA_FUZZ_SECONDS=N   seconds per fuzz target (default 20; 0 skips the fuzzing)
 #   PENUMBRA_JOBS=N           build jobs (default: cores)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh || { echo "setup failed"; exit 1; }
 jobs=${PENUMBRA_JOBS:-$(nproc)}
-fuzz_seconds=${PENUMBRA_FUZZ_SECONDS:-30}
+fuzz_seconds=${PENUMBRA_FUZZ_SECONDS:-20}
 started=$SECONDS
 # Elapsed time since the start, printed with each phase (the whole command must stay well under
 # 30 minutes on CI's 2 cores).
