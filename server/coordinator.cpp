@@ -274,8 +274,10 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
                                                const CallContext& caller) {
   // Validation and scene parsing happen outside the lock: they can take a while.
   if (spec.method().empty()) throw invalid("spec.method: empty; give a method such as \"sa\"");
+  // The method is parsed once here; the check against the scene below reuses it.
+  MethodSpec method;
   try {
-    parse_method(spec.method());
+    method = parse_method(spec.method());
   } catch (const FormatError& error) {
     throw invalid(error.what());
   }
@@ -365,7 +367,7 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
   // The method must be able to run on this scene (line-bd16 refuses GGX, the Peters
   // combinations need psa and ltc, ...): refused now, not after a worker's three failures.
   try {
-    check_method_runs_on(*scene, parse_method(spec.method()));
+    check_method_runs_on(*scene, method);
   } catch (const FormatError& error) {
     throw invalid(error.what());
   }

@@ -1,7 +1,8 @@
 #include "worker/task_decoding.h"
 
 #include <algorithm>
-#include <cstring>
+#include <optional>
+#include <utility>
 
 #include "core/sampling/pattern.h"
 
@@ -41,18 +42,20 @@ bool is_scene_content_hash(std::string_view text) {
          });
 }
 
-void check_task_fields(const v1::Task& task) {
+TaskFields check_task_fields(const v1::Task& task) {
   if (task.job_id().empty()) refuse("job_id", "empty");
   if (task.attempt_token().empty()) refuse("attempt_token", "empty");
   if (!is_scene_content_hash(task.scene_hash()))
     refuse("scene_hash", quoted(task.scene_hash()) + " is not 64 lowercase hex digits");
+  TaskFields fields;
   try {
-    parse_method(task.method());
+    fields.method = parse_method(task.method());
   } catch (const FormatError& error) {
     refuse("method", error.what());
   }
-  if (!parse_pattern(task.sampler()))
-    refuse("sampler", "unknown sampler " + quoted(task.sampler()));
+  const std::optional<Pattern> sampler = parse_pattern(task.sampler());
+  if (!sampler) refuse("sampler", "unknown sampler " + quoted(task.sampler()));
+  fields.sampler = *sampler;
   if (!task.has_tile()) refuse("tile", "missing");
   const v1::TileRect& tile = task.tile();
   if (tile.x0() < 0 || tile.y0() < 0)
@@ -65,10 +68,14 @@ void check_task_fields(const v1::Task& task) {
   if (task.pass_end() <= task.pass_begin())
     refuse("pass_end", "pass range [" + std::to_string(task.pass_begin()) + ", " +
                            std::to_string(task.pass_end()) + ") is empty");
+  return fields;
 }
 
 DecodedTask decode_task(const v1::Task& task, const Scene& scene) {
-  check_task_fields(task);
+  return decode_task(task, check_task_fields(task), scene);
+}
+
+DecodedTask decode_task(const v1::Task& task, TaskFields fields, const Scene& scene) {
   if (task.scene_hash() != scene.content_hash)
     refuse("scene_hash", quoted(task.scene_hash()) + " is not the hash of the scene given (" +
                              quoted(scene.content_hash) + ")");
@@ -83,9 +90,9 @@ DecodedTask decode_task(const v1::Task& task, const Scene& scene) {
   decoded.tile = {tile.x0(), tile.y0(), tile.x1(), tile.y1()};
   decoded.pass_begin = task.pass_begin();
   decoded.pass_end = task.pass_end();
-  decoded.method = parse_method(task.method());
+  decoded.method = std::move(fields.method);
   decoded.options.method = task.method();
-  decoded.options.sampler = *parse_pattern(task.sampler());
+  decoded.options.sampler = fields.sampler;
   decoded.options.seed = task.seed();
   return decoded;
 }
@@ -108,23 +115,6 @@ TileAccumulator decode_result_tile(std::string_view bytes, const TileRect& rect,
       throw TaskDecodingError("tile: pixel " + std::to_string(i) + " has " +
                               std::to_string(tile.count(i)) + " samples, the task asked for " +
                               std::to_string(passes));
-  // Per sample, add_sample clamps a value to 2^60 and its square to 2^60 as well; in 2^-32
-  // fixed point a pixel's sum and sum of squares therefore stay within passes * 2^92.
-  // The serialized layout (core/render/tile.cpp): a 28-byte header (magic, rect, non-finite
-  // count), then 3 sums per pixel, 3 squares per pixel (16 bytes each), then the counts.
-  const unsigned __int128 bound = static_cast<unsigned __int128>(passes) << 92;
-  constexpr size_t kHeaderBytes = 28;
-  for (int64_t k = 0; k < 6 * pixels; ++k) {
-    Fixed128 value;
-    std::memcpy(&value, bytes.data() + kHeaderBytes + 16 * size_t(k), sizeof(value));
-    const bool is_square = k >= 3 * pixels;
-    unsigned __int128 magnitude =
-        value < 0 ? -static_cast<unsigned __int128>(value) : static_cast<unsigned __int128>(value);
-    if ((is_square && value < 0) || magnitude > bound)
-      throw TaskDecodingError(std::string("tile: pixel ") +
-                              std::to_string((is_square ? k - 3 * pixels : k) / 3) + " has a " +
-                              (is_square ? "sum of squares" : "sum") + " no sample could produce");
-  }
   return tile;
 }
 

@@ -27,26 +27,35 @@ struct DecodedTask {
   uint32_t pass_begin = 0;
   uint32_t pass_end = 0;
   MethodSpec method;      // the parsed method (its text is in options.method)
-  RenderOptions options;  // method text, sampler and seed, as the Renderer takes them
+  RenderOptions options;  // method text, sampler and seed, as the Renderer takes them (with
+                          // `method` already parsed)
 };
 
 // A content hash as core computes it (scene_package.h): 64 lowercase hex digits. Cache files are
 // named by it, so nothing else (no "../", no upper case, no other length) is accepted.
 bool is_scene_content_hash(std::string_view text);
 
+// What check_task_fields parsed: the method and the sampler (each parsed once per task).
+struct TaskFields {
+  MethodSpec method;
+  Pattern sampler = Pattern::Stratified;
+};
+
 // The checks that need no scene: ids present, scene hash well formed, method and sampler known,
 // tile not empty and not negative, pass range not empty. Throws TaskDecodingError.
-void check_task_fields(const v1::Task& task);
+TaskFields check_task_fields(const v1::Task& task);
 
-// check_task_fields, then the checks against the task's scene: its content hash matches and the
-// tile lies inside the image. Throws TaskDecodingError.
+// The checks against the task's scene, for fields check_task_fields returned for this task: its
+// content hash matches and the tile lies inside the image. Throws TaskDecodingError.
+DecodedTask decode_task(const v1::Task& task, TaskFields fields, const Scene& scene);
+// check_task_fields, then the above.
 DecodedTask decode_task(const v1::Task& task, const Scene& scene);
 
-// A task's result tile as the coordinator should accept it: it deserializes, has the task's
-// rect, every pixel counts exactly `passes` samples, and every sum and sum of squares lies in the
-// range add_sample can reach (|value| <= 2^60 per sample), so that merging the results of any
-// number of tasks cannot overflow the 128-bit fixed-point sums (signed overflow is undefined
-// behaviour). Throws TaskDecodingError ("tile: ...").
+// A task's result tile as the coordinator should accept it: it deserializes (which refuses sums
+// and sums of squares beyond what its counts' samples can reach, core/render/tile.h, so that
+// merging the results of any number of tasks cannot overflow the 128-bit fixed-point sums), has
+// the task's rect, and every pixel counts exactly `passes` samples. Throws TaskDecodingError
+// ("tile: ...").
 TileAccumulator decode_result_tile(std::string_view bytes, const TileRect& rect, uint32_t passes);
 
 }  // namespace penumbra::farm

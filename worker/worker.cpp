@@ -298,10 +298,10 @@ void RenderWorker::render_loop() {
     try {
       // Fields first (the scene hash names a cache file), then against the scene: the tile
       // inside the image, the pass range not empty (worker/task_decoding.h).
-      check_task_fields(task);
+      TaskFields fields = check_task_fields(task);
       std::shared_ptr<const PreparedScene> prepared = prepared_for(task.scene_hash());
-      DecodedTask decoded = decode_task(task, prepared->scene());
-      std::shared_ptr<const Renderer> renderer = renderer_for(task, prepared);
+      const DecodedTask decoded = decode_task(task, std::move(fields), prepared->scene());
+      std::shared_ptr<const Renderer> renderer = renderer_for(task, decoded, prepared);
       const TileRect rect = decoded.tile;
       TileAccumulator accumulator(rect);
       // Compute seconds: with one thread the arena runs the task on this thread (its one slot
@@ -504,7 +504,8 @@ void RenderWorker::evict_prepared_locked(const std::string& keep) {
 }
 
 std::shared_ptr<const Renderer> RenderWorker::renderer_for(
-    const v1::Task& task, const std::shared_ptr<const PreparedScene>& prepared) {
+    const v1::Task& task, const DecodedTask& decoded,
+    const std::shared_ptr<const PreparedScene>& prepared) {
   std::ostringstream key;
   key << task.job_id() << '|' << task.scene_hash() << '|' << task.method() << '|' << task.sampler()
       << '|' << task.seed();
@@ -516,14 +517,8 @@ std::shared_ptr<const Renderer> RenderWorker::renderer_for(
       return it->second.renderer;
     }
   }
-  RenderOptions render_options;
-  render_options.method = task.method();
-  auto pattern = parse_pattern(task.sampler());
-  if (!pattern) throw std::runtime_error("unknown sampler \"" + task.sampler() + "\"");
-  render_options.sampler = *pattern;
-  render_options.seed = task.seed();
   // Only the method's estimator is new; the scene's BVHs and textures are the prepared scene's.
-  auto renderer = std::make_shared<const Renderer>(prepared, render_options);
+  auto renderer = std::make_shared<const Renderer>(prepared, decoded.options, decoded.method);
   std::lock_guard lock(cache_mutex_);
   renderers_[key.str()] = {task.scene_hash(), renderer, ++use_clock_};
   if (renderers_.size() > kMaxRenderers) {

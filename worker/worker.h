@@ -29,6 +29,7 @@
 #include "core/render/prepared_scene.h"
 #include "core/render/renderer.h"
 #include "penumbra/v1/farm.grpc.pb.h"
+#include "worker/task_decoding.h"
 
 namespace penumbra::farm {
 
@@ -95,8 +96,10 @@ class RenderWorker {
   // method; kept by content hash within max_prepared_bytes, least recently used evicted first.
   std::shared_ptr<const PreparedScene> prepared_for(const std::string& hash);
   void evict_prepared_locked(const std::string& keep);
+  // The renderer of a decoded task (cached per job, scene, method, sampler and seed).
   std::shared_ptr<const Renderer> renderer_for(
-      const v1::Task& task, const std::shared_ptr<const PreparedScene>& prepared);
+      const v1::Task& task, const DecodedTask& decoded,
+      const std::shared_ptr<const PreparedScene>& prepared);
   void backoff();
   void reset_backoff() { backoff_ = std::chrono::milliseconds(0); }
 

@@ -14,9 +14,10 @@
 namespace penumbra {
 
 struct Renderer::Impl {
-  Impl(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options)
+  Impl(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options,
+       const MethodSpec& method)
       : options(options),
-        shading(prepared, parse_method(options.method)),
+        shading(prepared, method),
         camera(prepared->scene().camera),
         filter(prepared->scene().camera.filter) {}
   RenderOptions options;
@@ -26,11 +27,15 @@ struct Renderer::Impl {
 };
 
 Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderOptions& options)
-    : impl_(std::make_unique<Impl>(std::make_shared<const PreparedScene>(std::move(scene)),
-                                   options)) {}
+    : impl_(std::make_unique<Impl>(std::make_shared<const PreparedScene>(std::move(scene)), options,
+                                   parse_method(options.method))) {}
 
 Renderer::Renderer(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options)
-    : impl_(std::make_unique<Impl>(std::move(prepared), options)) {}
+    : impl_(std::make_unique<Impl>(std::move(prepared), options, parse_method(options.method))) {}
+
+Renderer::Renderer(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options,
+                   const MethodSpec& method)
+    : impl_(std::make_unique<Impl>(std::move(prepared), options, method)) {}
 
 Renderer::~Renderer() = default;
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/method/method.h"
 #include "core/render/prepared_scene.h"
 #include "core/render/tile.h"
 #include "core/sampling/pattern.h"
@@ -32,6 +33,10 @@ class Renderer {
   // Over a prepared scene shared with other renderers (other methods, samplers, seeds): only
   // the method's estimator is built here.
   Renderer(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options);
+  // The same with options.method already parsed into `method` (its text stays in the options for
+  // the image's metadata): a worker parses each task's method once, where it decodes the task.
+  Renderer(std::shared_ptr<const PreparedScene> prepared, const RenderOptions& options,
+           const MethodSpec& method);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
