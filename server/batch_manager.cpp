@@ -464,6 +464,8 @@ v1::JobSpec BatchManager::run_spec(const Batch& batch, const v1::BatchMethodStat
   std::string name = batch.stored.status().batch_id();
   name.append(" ").append(method.label()).append(" r").append(std::to_string(repeat));
   spec.set_name(name + (equal_time ? " equal time" : ""));
+  // The batch's regions (the scene's and the spec's): every curve point measures each of them.
+  *spec.mutable_regions() = batch.stored.status().regions();
   attach_reference(batch, spec);
   return spec;
 }

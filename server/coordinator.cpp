@@ -61,16 +61,27 @@ uint32_t blocks_for_passes(const v1::StoredJob& stored, uint32_t spp) {
   return uint32_t(first_block + (spp - first_pass + passes - 1) / passes);
 }
 
+// The regions a job measures (curve points, final errors): the scene's, then the spec's (a
+// batch's regions), which replace a scene region of the same name.
+std::map<std::string, Region> measured_regions(const Scene& scene, const v1::JobSpec& spec) {
+  std::map<std::string, Region> regions = scene.regions;
+  for (const v1::BatchRegion& region : spec.regions())
+    regions[region.name()] = {region.rect().x0(), region.rect().y0(), region.rect().x1(),
+                              region.rect().y1()};
+  return regions;
+}
+
 }  // namespace
 
 struct Coordinator::Job {
   JobRecord record;
   v1::StoredJob stored;
   uint64_t tile_count = 0;
-  std::vector<TileRect> tiles;          // empty once the job ended
-  std::shared_ptr<const Scene> scene;   // null once the job ended
-  uint32_t total_blocks = 0;            // spp budget; seconds budget: the most it may open
-  std::vector<TileAccumulator> sealed;  // per tile, blocks [0, blocks_sealed)
+  std::vector<TileRect> tiles;            // empty once the job ended
+  std::shared_ptr<const Scene> scene;     // null once the job ended
+  std::map<std::string, Region> regions;  // measured_regions, while the scene is known
+  uint32_t total_blocks = 0;              // spp budget; seconds budget: the most it may open
+  std::vector<TileAccumulator> sealed;    // per tile, blocks [0, blocks_sealed)
   struct PendingResult {
     TileAccumulator tile;
     double compute_seconds = 0;
@@ -194,6 +205,7 @@ void Coordinator::resume(const JobRecord& record) {
     v1::ScenePackage scene_package;
     scene_package.ParseFromString(*package);
     j.scene = std::make_shared<const Scene>(parser_(scene_package));
+    j.regions = measured_regions(*j.scene, j.spec());
     j.tiles = cut_tiles(int(j.stored.width()), int(j.stored.height()), int(tile_size));
     j.sealed.reserve(j.tiles.size());
     auto sealed = store_.tiles(record.id);
@@ -372,6 +384,21 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
     throw invalid(error.what());
   }
 
+  for (int i = 0; i < spec.regions_size(); ++i) {
+    const v1::BatchRegion& region = spec.regions(i);
+    const v1::TileRect& rect = region.rect();
+    const std::string field = "spec.regions[" + std::to_string(i) + "]";
+    if (region.name().empty() || region.name() == "image")
+      throw invalid(field + ".name: a region needs a name other than \"image\"");
+    if (rect.x0() < 0 || rect.y0() < 0 || rect.x0() >= rect.x1() || rect.y0() >= rect.y1() ||
+        rect.x1() > scene->camera.width || rect.y1() > scene->camera.height)
+      throw invalid(field + ".rect: [" + std::to_string(rect.x0()) + ", " +
+                    std::to_string(rect.y0()) + ", " + std::to_string(rect.x1()) + ", " +
+                    std::to_string(rect.y1()) + ") is empty or outside the " +
+                    std::to_string(scene->camera.width) + "x" +
+                    std::to_string(scene->camera.height) + " image");
+  }
+
   std::optional<Image> reference;
   if (spec.reference_case() == v1::JobSpec::kReferenceExr) {
     ImageMetadata reference_metadata;
@@ -432,6 +459,7 @@ v1::SubmitJobResponse Coordinator::submit_spec(v1::JobSpec spec, bool awaits_pas
                       "the coordinator's queue is full: " + std::to_string(new_tasks) +
                           " more tasks would exceed " + std::to_string(options_.max_queued_tasks));
     job->scene = scene;
+    job->regions = measured_regions(*scene, spec);
     job->reference = std::move(reference);
     job->record.spec = job->stored.SerializeAsString();
     job->record.priority = spec.priority();
@@ -535,6 +563,8 @@ void Coordinator::seal_ready_blocks(Job& job) {
         p.compute_seconds = job.record.compute_seconds;
         p.wall_seconds = double(unix_ms() - job.record.started_unix_ms) / 1000.0;
         p.mrse = mrse(film.color, *job.reference);
+        for (const auto& [region, summary] : error_summary(film.color, *job.reference, job.regions))
+          if (region != "image") p.regions.emplace_back(region, summary.mrse);
         point = p;
         job.curve.push_back(p);
         job.has_mrse = true;
@@ -707,8 +737,7 @@ void Coordinator::record_final_errors(Job& job, const Film& film) {
   job.errors.Clear();
   if (!job.reference) return;
   try {
-    for (const auto& [region, summary] :
-         error_summary(film.color, *job.reference, job.scene->regions)) {
+    for (const auto& [region, summary] : error_summary(film.color, *job.reference, job.regions)) {
       v1::RegionError* error = job.errors.add_errors();
       error->set_region(region);
       error->set_mrse(summary.mrse);
@@ -858,6 +887,11 @@ v1::JobStatus Coordinator::status_locked(const Job& job, bool with_curve) const 
       sample->set_compute_seconds(point.compute_seconds);
       sample->set_wall_seconds(point.wall_seconds);
       sample->set_mrse(point.mrse);
+      for (const auto& [region, value] : point.regions) {
+        v1::RegionError* error = sample->add_regions();
+        error->set_region(region);
+        error->set_mrse(value);
+      }
     }
   }
   *status.mutable_errors() = job.errors.errors();
@@ -1460,7 +1494,7 @@ std::optional<std::string> Coordinator::reference_exr(const std::string& job_id)
 std::map<std::string, Region> Coordinator::regions(const std::string& job_id) {
   std::lock_guard lock(mutex_);
   const Job& job = job_locked(job_id);
-  return job.scene ? job.scene->regions : std::map<std::string, Region>{};
+  return job.regions;
 }
 
 }  // namespace penumbra::farm

@@ -112,7 +112,7 @@ std::vector<ChartSpec> job_convergence_charts(const v1::JobStatus& status) {
   for (const v1::ErrorSample& sample : status.curve())
     if (sample.mrse() > 0 && std::isfinite(sample.mrse()))
       run.curve.push_back(
-          {sample.passes(), sample.compute_seconds(), sample.wall_seconds(), sample.mrse()});
+          {sample.passes(), sample.compute_seconds(), sample.wall_seconds(), sample.mrse(), {}});
   if (run.curve.empty()) return {};
   ErrorSummary last;
   last.mrse = run.curve.back().mrse;

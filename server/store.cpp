@@ -33,6 +33,9 @@ CREATE TABLE IF NOT EXISTS tiles (
 CREATE TABLE IF NOT EXISTS curve (
   job_id INTEGER NOT NULL, passes INTEGER NOT NULL, compute_seconds REAL NOT NULL,
   wall_seconds REAL NOT NULL, mrse REAL NOT NULL, PRIMARY KEY (job_id, passes));
+CREATE TABLE IF NOT EXISTS curve_regions (
+  job_id INTEGER NOT NULL, passes INTEGER NOT NULL, region TEXT NOT NULL, mrse REAL NOT NULL,
+  PRIMARY KEY (job_id, passes, region));
 )sql";
 
 }  // namespace
@@ -470,6 +473,17 @@ void Store::seal_block(const JobRecord& job, const std::map<uint32_t, std::strin
           .bind(4, point->wall_seconds)
           .bind(5, point->mrse)
           .run();
+      Statement insert(*this,
+                       "INSERT OR REPLACE INTO curve_regions (job_id, passes, region, mrse) "
+                       "VALUES (?, ?, ?, ?)");
+      for (const auto& [region, mrse] : point->regions) {
+        insert.bind(1, int64_t(job.id))
+            .bind(2, int64_t(point->passes))
+            .bind_text(3, region)
+            .bind(4, mrse)
+            .run();
+        insert.reset();
+      }
     }
     write_job_fields(job);
     transaction.commit();
@@ -493,8 +507,22 @@ std::vector<CurvePoint> Store::curve(uint64_t job_id) {
   statement.bind(1, int64_t(job_id));
   std::vector<CurvePoint> points;
   while (statement.step())
-    points.push_back(
-        {uint32_t(statement.integer(0)), statement.real(1), statement.real(2), statement.real(3)});
+    points.push_back({uint32_t(statement.integer(0)),
+                      statement.real(1),
+                      statement.real(2),
+                      statement.real(3),
+                      {}});
+  Statement regions(*this,
+                    "SELECT passes, region, mrse FROM curve_regions WHERE job_id = ? "
+                    "ORDER BY passes, region");
+  regions.bind(1, int64_t(job_id));
+  size_t at = 0;
+  while (regions.step()) {
+    const uint32_t passes = uint32_t(regions.integer(0));
+    while (at < points.size() && points[at].passes < passes) ++at;
+    if (at < points.size() && points[at].passes == passes)
+      points[at].regions.emplace_back(regions.blob(1), regions.real(2));
+  }
   return points;
 }
 

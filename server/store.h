@@ -24,6 +24,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "server/farm_error.h"
@@ -55,7 +56,8 @@ struct CurvePoint {
   uint32_t passes = 0;
   double compute_seconds = 0;
   double wall_seconds = 0;
-  double mrse = 0;
+  double mrse = 0;                                      // the full image's
+  std::vector<std::pair<std::string, double>> regions;  // (name, MRSE) of each region
 };
 
 struct StoreOptions {

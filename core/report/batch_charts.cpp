@@ -89,13 +89,21 @@ ChartSpec mrse_spp_chart(const BatchResult& result, const RecomputedErrors& reco
     std::set<uint32_t> spp_levels;
     for (const BatchRun& run : method.runs) spp_levels.insert(run.spp);
     GroupedPoints points;
-    if (spp_levels.size() == 1 && region == "image") {
+    if (spp_levels.size() == 1) {
+      // One spp level (an equal-time run): the farm's curve, measured at every sealed pass
+      // block, for the image and for each region (results written before the curve carried
+      // regions have none there).
       for (const BatchRun& run : method.runs)
-        for (const BatchCurvePoint& point : run.curve)
-          points.add(point.passes, double(point.passes), point.mrse);
+        for (const BatchCurvePoint& point : run.curve) {
+          if (region == "image") {
+            points.add(point.passes, double(point.passes), point.mrse);
+          } else if (auto it = point.regions.find(region); it != point.regions.end()) {
+            points.add(point.passes, double(point.passes), it->second);
+          }
+        }
     }
-    // A region of a method with one spp level (an equal-time run): the farm measured no curve
-    // there, so each repeat is its own point (its spp and its error), not one mean.
+    // A region of a method with one spp level and no region curve: each repeat is its own
+    // point (its spp and its error), not one mean.
     const bool per_repeat = spp_levels.size() == 1 && points.y.empty();
     if (points.y.empty()) {
       for (size_t r = 0; r < method.runs.size(); ++r)

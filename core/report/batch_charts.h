@@ -30,10 +30,10 @@ ChartSpec mrse_time_chart(const BatchResult& result, const RecomputedErrors& rec
                           const ChartAnnotations& annotations = {});
 
 // MRSE of `region` ("image" or a region's name) against spp. Per method: the runs' recomputed
-// errors, mean per spp level; when a method has a single spp level and region is "image", the
-// curve's points instead (the farm measured them at pass boundaries), and for another region
-// one point per repeat (no curve exists there). A fitted line whenever a series of means has two
-// or more spp values.
+// errors, mean per spp level; when a method has a single spp level, the curve's points instead
+// (the farm measured the image and every region at pass boundaries), or one point per repeat
+// for a region the curve lacks (results written before curves carried regions). A fitted line
+// whenever a series of means has two or more spp values.
 ChartSpec mrse_spp_chart(const BatchResult& result, const RecomputedErrors& recomputed,
                          const std::string& region, const ChartAnnotations& annotations = {});
 

@@ -208,7 +208,10 @@ BatchResult corrected_curves(const BatchResult& result, const ReferenceNoise& no
   BatchResult copy = result;
   for (BatchMethod& method : copy.methods)
     for (BatchRun& run : method.runs)
-      for (BatchCurvePoint& point : run.curve) point.mrse = noise.corrected("image", point.mrse);
+      for (BatchCurvePoint& point : run.curve) {
+        point.mrse = noise.corrected("image", point.mrse);
+        for (auto& [region, value] : point.regions) value = noise.corrected(region, value);
+      }
   return copy;
 }
 

@@ -126,6 +126,11 @@ BatchRun parse_run(const KeyNode& node, bool budgeted) {
       p.compute_seconds = point.required("compute_seconds").non_negative();
       if (auto wall = point.optional("wall_seconds")) p.wall_seconds = wall->non_negative();
       p.mrse = point.required("mrse").non_negative();
+      if (auto regions = point.optional("regions")) {
+        regions->expect_object();
+        for (const auto& [name, value] : regions->value().items())
+          p.regions[name] = regions->required(name).non_negative();
+      }
       run.curve.push_back(p);
     }
   }

@@ -36,7 +36,8 @@ struct BatchCurvePoint {
   uint32_t passes = 0;
   double compute_seconds = 0;
   double wall_seconds = 0;
-  double mrse = 0;
+  double mrse = 0;                        // the full image's
+  std::map<std::string, double> regions;  // each region's MRSE (absent in older results)
 };
 
 struct BatchRun {

@@ -294,11 +294,15 @@ void write_batch_result(BatchClient& client, const v1::BatchStatus& status,
           errors.push_back(e);
       }
       nlohmann::json curve = nlohmann::json::array();
-      for (const v1::ErrorSample& point : job.curve())
+      for (const v1::ErrorSample& point : job.curve()) {
+        nlohmann::json regions = nlohmann::json::object();
+        for (const v1::RegionError& error : point.regions()) regions[error.region()] = error.mrse();
         curve.push_back({{"passes", point.passes()},
                          {"compute_seconds", point.compute_seconds()},
                          {"wall_seconds", point.wall_seconds()},
-                         {"mrse", point.mrse()}});
+                         {"mrse", point.mrse()},
+                         {"regions", regions}});
+      }
       entry["runs"].push_back({{"repeat", run.repeat()},
                                {"seed", run.seed()},
                                {"job_id", run.job_id()},

@@ -117,7 +117,19 @@ TEST(BatchFarm, EqualTimeByCalibrationAndTheResultFolder) {
       EXPECT_GT(run["spp"].get<int>(), 0);
       EXPECT_GT(run["compute_seconds"].get<double>(), 0);
       EXPECT_FALSE(run["curve"].empty());
-      for (const auto& point : run["curve"]) EXPECT_GT(point["mrse"].get<double>(), 0);
+      for (const auto& point : run["curve"]) {
+        EXPECT_GT(point["mrse"].get<double>(), 0);
+        // Every region, the spec's "corner" too (background: MRSE 0), at every point.
+        for (const auto& [name, rect] : regions)
+          EXPECT_GE(point["regions"].value(name, -1.0), 0) << name << ": " << point.dump();
+        EXPECT_GT(point["regions"].value("shadow", -1.0), 0) << point.dump();
+      }
+      // The last point is the run's image: its regions' MRSE are the EXR's.
+      const auto& last = run["curve"].back();
+      if (last["passes"].get<int>() == run["spp"].get<int>()) {
+        for (const auto& [name, rect] : regions)
+          EXPECT_EQ(last["regions"][name].get<double>(), expected.at(name).mrse) << name;
+      }
     }
   }
   EXPECT_EQ(runs, 4);

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <thread>
 
+#include "core/image/metrics.h"
 #include "fake_worker.h"
 #include "farm_test_support.h"
 #include "proto/support/scene_packing.h"
@@ -398,6 +399,56 @@ TEST_F(CoordinatorTest, SceneWarningsAndReferenceMismatchesAreCarriedOrRefused) 
   v1::JobSpec same = typo;
   same.set_reference_job(job);
   EXPECT_EQ(coordinator->status(coordinator->submit(same).job_id()).warnings_size(), 1);
+}
+
+// Every curve point measures the scene's regions and the spec's (a batch's) besides the full
+// image: exactly the MRSE of the image of that many passes there, also after a restart.
+TEST_F(CoordinatorTest, CurvePointsCarryTheMrseOfEveryRegion) {
+  const std::map<std::string, Region> regions = {{"shadow", {8, 8, 24, 24}},
+                                                 {"left", {0, 0, 16, 24}}};
+  const Image reference = expected_film(40, 24, 16).color;
+  v1::JobSpec job_spec = spec(8);  // 2 blocks of 4 passes: curve points at 4 and 8 passes
+  job_spec.set_reference_exr(encode_exr(reference, nullptr, {}));
+  v1::BatchRegion* left = job_spec.add_regions();
+  left->set_name("left");
+  left->mutable_rect()->set_x1(16);
+  left->mutable_rect()->set_y1(24);
+  std::string job;
+  auto check = [&](const v1::JobStatus& status) {
+    ASSERT_EQ(status.curve_size(), 2);
+    for (const v1::ErrorSample& point : status.curve()) {
+      const auto expected =
+          error_summary(expected_film(40, 24, point.passes()).color, reference, regions);
+      EXPECT_EQ(point.mrse(), expected.at("image").mrse);
+      ASSERT_EQ(point.regions_size(), 2) << point.passes();
+      for (const v1::RegionError& error : point.regions())
+        EXPECT_EQ(error.mrse(), expected.at(error.region()).mrse)
+            << error.region() << " at " << point.passes();
+    }
+    bool final_left = false;
+    for (const v1::RegionError& error : status.errors()) final_left |= error.region() == "left";
+    EXPECT_TRUE(final_left) << "the final errors lack the spec's region";
+  };
+  {
+    auto coordinator = make();
+    std::string worker = register_worker(*coordinator, "w");
+    v1::JobSpec outside = job_spec;
+    outside.mutable_regions(0)->mutable_rect()->set_x1(41);
+    try {
+      coordinator->submit(outside);
+      ADD_FAILURE() << "a region outside the image was accepted";
+    } catch (const FarmError& error) {
+      EXPECT_EQ(error.code(), FarmErrorCode::InvalidArgument);
+      EXPECT_NE(std::string(error.what()).find("spec.regions[0].rect"), std::string::npos)
+          << error.what();
+    }
+    job = coordinator->submit(job_spec).job_id();
+    for (const v1::Task& task : lease(*coordinator, worker, 100))
+      EXPECT_TRUE(complete(*coordinator, worker, task));
+    ASSERT_EQ(coordinator->status(job).state(), v1::JOB_STATE_DONE);
+    check(coordinator->status(job, true));
+  }
+  check(make()->status(job, true));
 }
 
 TEST_F(CoordinatorTest, SecondsBudgetOpensBlocksUntilTheBudgetIsSpent) {

@@ -67,7 +67,7 @@ TEST(Store, SealingReplacesTaskResultsWithTileSums) {
   for (uint64_t task = 0; task < 6; ++task) store.add_task_result(job.id, {task, "r", 0.1});
   job.blocks_sealed = 1;
   store.seal_block(job, {{0, "sum0"}, {1, "sum1"}, {2, "sum2"}}, 0, 3,
-                   CurvePoint{8, 1.5, 2.0, 0.25});
+                   CurvePoint{8, 1.5, 2.0, 0.25, {{"shadow", 0.5}, {"corner", 0.125}}});
   auto results = store.task_results(job.id);
   ASSERT_EQ(results.size(), 3u);
   EXPECT_EQ(results[0].task_index, 3u);
@@ -81,6 +81,8 @@ TEST(Store, SealingReplacesTaskResultsWithTileSums) {
   ASSERT_EQ(curve.size(), 1u);
   EXPECT_EQ(curve[0].passes, 8u);
   EXPECT_DOUBLE_EQ(curve[0].mrse, 0.25);
+  EXPECT_EQ(curve[0].regions,
+            (std::vector<std::pair<std::string, double>>{{"corner", 0.125}, {"shadow", 0.5}}));
   EXPECT_EQ(store.jobs()[0].blocks_sealed, 1u);
   store.drop_work(job);
   EXPECT_TRUE(store.tiles(job.id).empty());
