@@ -19,6 +19,7 @@ BatchMethod budget_method(const std::string& label, std::vector<double> seconds,
     BatchRun run;
     run.repeat = int(r);
     run.spp = 10;
+    run.equal_time = true;  // the method's equal-time runs (not spp-level ones)
     run.compute_seconds = seconds[r];
     method.runs.push_back(run);
     ErrorSummary error;
